@@ -1,0 +1,25 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace everytouch::core {
+
+// Homography from the plane z = heightMm of the table frame to a pinhole device's pixels (undistorted):
+// K [r1, r2, heightMm * r3 + t] (paper eq. 19-21). `tableToDevice` maps table millimetres into the device
+// frame.
+Eigen::Matrix3d planeToImageHomography(const Eigen::Matrix3d& intrinsics,
+                                       const Eigen::Isometry3d& tableToDevice, double heightMm);
+
+// Paper eq. 22: from the table-induced homography H = K [r1, r2, t] (exact scale) and p3 = K r3, the map that
+// takes the image of a table point (X, Y, 0) to the image of (X, Y, d): I + d [0, 0, p3] H^-1.
+Eigen::Matrix3d elevatedPlaneHomography(const Eigen::Matrix3d& tableHomography, const Eigen::Vector3d& p3,
+                                        double heightMm);
+
+// Projects a point given in table millimetres into a pinhole device's pixels (undistorted).
+Eigen::Vector2d projectPoint(const Eigen::Matrix3d& intrinsics, const Eigen::Isometry3d& tableToDevice,
+                             const Eigen::Vector3d& pointInTable);
+
+Eigen::Vector2d applyHomography(const Eigen::Matrix3d& homography, const Eigen::Vector2d& point);
+
+}  // namespace everytouch::core

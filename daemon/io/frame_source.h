@@ -1,0 +1,26 @@
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "core/frame.h"
+#include "io/rig_description.h"
+
+namespace everytouch::io {
+
+// A stream of camera frames: a camera, the simulator or a recording. `next` blocks until the next frame
+// (paced in real time unless the source was asked to run fast) and returns nothing at the end of the stream.
+class FrameSource {
+public:
+    virtual ~FrameSource() = default;
+
+    virtual std::optional<core::Frame> next() = 0;
+
+    // The rig's own description when the source knows it (simulator, recording); cameras rely on the
+    // calibration store instead.
+    virtual std::optional<RigDescription> rig() const = 0;
+
+    virtual std::string describe() const = 0;
+};
+
+}  // namespace everytouch::io

@@ -1,0 +1,249 @@
+#include "io/recording.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <string_view>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "io/atomic_file.h"
+#include "io/calibration_file.h"
+#include "io/input_error.h"
+
+namespace everytouch::io {
+
+namespace {
+
+std::vector<std::string_view> splitFields(std::string_view line) {
+    std::vector<std::string_view> fields;
+    size_t start = 0;
+    while (true) {
+        const size_t comma = line.find(',', start);
+        fields.push_back(
+            line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+        if (comma == std::string_view::npos)
+            return fields;
+        start = comma + 1;
+    }
+}
+
+template <typename T>
+bool parseNumber(std::string_view text, T& value) {
+    while (!text.empty() && text.front() == ' ')
+        text.remove_prefix(1);
+    while (!text.empty() && (text.back() == ' ' || text.back() == '\r'))
+        text.remove_suffix(1);
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+    if (error != std::errc() || end != text.data() + text.size())
+        return false;
+    if constexpr (std::is_floating_point_v<T>)
+        return std::isfinite(value);
+    return true;
+}
+
+// Reads a CSV file with the exact header `header`; calls `row(fields, where)` for each non-empty line.
+template <typename RowHandler>
+void readCsv(const std::filesystem::path& path, const std::string& header, size_t fieldCount,
+             RowHandler row) {
+    std::ifstream input(path);
+    if (!input)
+        throw InputError(path.string(), "", "cannot be opened");
+    std::string line;
+    if (!std::getline(input, line) ||
+        (line.ends_with('\r') ? line.substr(0, line.size() - 1) : line) != header)
+        throw InputError(path.string(), "line 1", "expected the header \"" + header + "\"");
+    for (size_t number = 2; std::getline(input, line); ++number) {
+        if (line.empty() || line == "\r")
+            continue;
+        const std::string where = "line " + std::to_string(number);
+        const auto fields = splitFields(line);
+        if (fields.size() != fieldCount)
+            throw InputError(path.string(), where,
+                             "expected " + std::to_string(fieldCount) + " fields, found " +
+                                 std::to_string(fields.size()) + " (truncated or malformed line)");
+        row(fields, where);
+    }
+}
+
+cv::Mat readPattern(const std::filesystem::path& path, const cv::Size& projectorSize) {
+    const std::string name = path.string();
+    if (!std::filesystem::is_regular_file(path))
+        throw InputError(name, "", "missing");
+    cv::Mat image = cv::imread(name, cv::IMREAD_UNCHANGED);
+    if (image.empty())
+        throw InputError(name, "", "not a readable image");
+    if (image.type() != CV_8UC1)
+        throw InputError(name, "", "expected an 8-bit single-channel image");
+    if (image.size() != projectorSize)
+        throw InputError(name, "",
+                         "expected the projector size " + std::to_string(projectorSize.width) + "x" +
+                             std::to_string(projectorSize.height));
+    const int nonBinary = image.total() - cv::countNonZero(image == 0) - cv::countNonZero(image == 255);
+    if (nonBinary != 0)
+        throw InputError(
+            name, "",
+            "expected only the values 0 and 255, found " + std::to_string(nonBinary) + " other pixels");
+    return image / 255;
+}
+
+}  // namespace
+
+std::filesystem::path Recording::framePath(const std::filesystem::path& directory, std::uint64_t index) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(index));
+    return directory / "frames" / name;
+}
+
+Recording Recording::open(const std::filesystem::path& directory) {
+    Recording recording;
+    recording.directory_ = directory;
+    if (!std::filesystem::is_directory(directory))
+        throw InputError(directory.string(), "", "not a recording directory");
+
+    const std::filesystem::path rigPath = directory / "rig.yml";
+    const std::string rigName = rigPath.string();
+    const cv::FileStorage storage = openYamlForReading(rigPath);
+    const cv::FileNode root = storage.root();
+    checkFormatHeader(root, rigName, {kRecordingFormat, kCalibrationFormat}, kRecordingVersion);
+    RigDescription& rig = recording.rig_;
+    rig.calibration = readCalibrationKeys(root, rigName);
+    const cv::FileNode delta = root["delta"];
+    if (delta.empty())
+        throw InputError(rigName, "delta", "missing");
+    if (!delta.isInt() || static_cast<int>(delta) < 1 || static_cast<int>(delta) > 127)
+        throw InputError(rigName, "delta", "expected an integer in 1..127");
+    rig.delta = static_cast<int>(delta);
+    const cv::FileNode frameRate = root["frame_rate"];
+    if (frameRate.empty())
+        throw InputError(rigName, "frame_rate", "missing");
+    if (!frameRate.isReal() && !frameRate.isInt())
+        throw InputError(rigName, "frame_rate", "expected a number");
+    rig.frameRate = static_cast<double>(frameRate);
+    if (!std::isfinite(rig.frameRate) || rig.frameRate <= 0)
+        throw InputError(rigName, "frame_rate", "expected a positive finite number");
+    const cv::FileNode pattern = root["pattern"];
+    if (pattern.empty())
+        throw InputError(rigName, "pattern", "missing");
+    if (!pattern.isString() || pattern.string().empty())
+        throw InputError(rigName, "pattern", "expected a file name");
+    rig.pattern = readPattern(directory / pattern.string(), rig.calibration.projectorSize);
+
+    const std::filesystem::path framesPath = directory / "frames.csv";
+    if (!std::filesystem::is_regular_file(framesPath))
+        throw InputError(framesPath.string(), "", "missing");
+    readCsv(framesPath, "index,timestamp_us,polarity", 3, [&](const auto& fields, const std::string& where) {
+        FrameEntry entry;
+        int polarity = 0;
+        if (!parseNumber(fields[0], entry.index))
+            throw InputError(framesPath.string(), where, "index: expected a non-negative integer");
+        if (!parseNumber(fields[1], entry.timestampUs))
+            throw InputError(framesPath.string(), where, "timestamp_us: expected an integer");
+        if (!parseNumber(fields[2], polarity) || (polarity != 1 && polarity != -1))
+            throw InputError(framesPath.string(), where, "polarity: expected 1 or -1");
+        entry.polarity = static_cast<core::Polarity>(polarity);
+        if (!recording.frames_.empty()) {
+            const FrameEntry& previous = recording.frames_.back();
+            if (entry.index <= previous.index)
+                throw InputError(framesPath.string(), where, "index: must increase from line to line");
+            if (entry.timestampUs < previous.timestampUs)
+                throw InputError(framesPath.string(), where, "timestamp_us: goes back in time");
+        }
+        if (!std::filesystem::is_regular_file(framePath(directory, entry.index)))
+            throw InputError(framePath(directory, entry.index).string(), "",
+                             "missing (listed in frames.csv " + where + ")");
+        recording.frames_.push_back(entry);
+    });
+
+    const std::filesystem::path truthPath = directory / "truth.csv";
+    if (std::filesystem::exists(truthPath)) {
+        recording.hasTruth_ = true;
+        readCsv(truthPath, "index,id,x,y,height_mm", 5, [&](const auto& fields, const std::string& where) {
+            core::FingerTruth finger;
+            if (!parseNumber(fields[0], finger.frameIndex))
+                throw InputError(truthPath.string(), where, "index: expected a non-negative integer");
+            if (!parseNumber(fields[1], finger.id))
+                throw InputError(truthPath.string(), where, "id: expected a non-negative integer");
+            if (!parseNumber(fields[2], finger.x))
+                throw InputError(truthPath.string(), where, "x: expected a finite number");
+            if (!parseNumber(fields[3], finger.y))
+                throw InputError(truthPath.string(), where, "y: expected a finite number");
+            if (!parseNumber(fields[4], finger.heightMm) || finger.heightMm < 0)
+                throw InputError(truthPath.string(), where, "height_mm: expected a finite number >= 0");
+            if (!recording.truth_.empty() && finger.frameIndex < recording.truth_.back().frameIndex)
+                throw InputError(truthPath.string(), where, "index: frames must be in increasing order");
+            recording.truth_.push_back(finger);
+        });
+    }
+    return recording;
+}
+
+core::Frame Recording::loadFrame(std::size_t position) const {
+    const FrameEntry& entry = frames_.at(position);
+    const std::filesystem::path path = framePath(directory_, entry.index);
+    core::Frame frame;
+    frame.image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    if (frame.image.empty())
+        throw InputError(path.string(), "", "not a readable image");
+    if (frame.image.type() != CV_8UC1 && frame.image.type() != CV_8UC3)
+        throw InputError(path.string(), "", "expected an 8-bit gray or BGR image");
+    if (frame.image.size() != rig_.calibration.cameraSize)
+        throw InputError(path.string(), "", "image size differs from camera_size in rig.yml");
+    frame.index = entry.index;
+    frame.timestampUs = entry.timestampUs;
+    frame.polarity = entry.polarity;
+    return frame;
+}
+
+RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig,
+                                 bool withTruth)
+    : directory_(directory) {
+    std::error_code error;
+    if (std::filesystem::exists(directory) && !std::filesystem::is_empty(directory))
+        throw InputError(directory.string(), "", "exists and is not empty; choose a new recording directory");
+    if (!std::filesystem::create_directories(directory / "frames", error) && error)
+        throw InputError(directory.string(), "", "cannot be created: " + error.message());
+
+    cv::FileStorage storage(".yml",
+                            cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+    storage << "format" << kRecordingFormat << "version" << kRecordingVersion;
+    writeCalibrationKeys(storage, rig.calibration);
+    storage << "delta" << rig.delta << "frame_rate" << rig.frameRate << "pattern"
+            << "pattern.png";
+    writeFileAtomically(directory / "rig.yml", storage.releaseAndGetString());
+    if (!cv::imwrite((directory / "pattern.png").string(), rig.pattern * 255))
+        throw InputError((directory / "pattern.png").string(), "", "cannot be written");
+
+    framesCsv_.open(directory / "frames.csv");
+    framesCsv_ << "index,timestamp_us,polarity\n";
+    if (withTruth) {
+        truthCsv_.open(directory / "truth.csv");
+        truthCsv_ << "index,id,x,y,height_mm\n";
+    }
+    if (!framesCsv_ || (withTruth && !truthCsv_))
+        throw InputError(directory.string(), "", "cannot write the frame and truth tables");
+}
+
+void RecordingWriter::addFrame(const core::Frame& frame) {
+    const std::filesystem::path path = Recording::framePath(directory_, frame.index);
+    if (!cv::imwrite(path.string(), frame.image))
+        throw InputError(path.string(), "", "cannot be written");
+    framesCsv_ << frame.index << ',' << frame.timestampUs << ',' << static_cast<int>(frame.polarity) << '\n';
+}
+
+void RecordingWriter::addTruth(const std::vector<core::FingerTruth>& fingers) {
+    char line[160];
+    for (const core::FingerTruth& finger : fingers) {
+        std::snprintf(line, sizeof line, "%llu,%u,%.3f,%.3f,%.3f\n",
+                      static_cast<unsigned long long>(finger.frameIndex), finger.id, finger.x, finger.y,
+                      finger.heightMm);
+        truthCsv_ << line;
+    }
+}
+
+void RecordingWriter::flush() {
+    framesCsv_.flush();
+    truthCsv_.flush();
+}
+
+}  // namespace everytouch::io

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "core/calibration.h"
+#include "core/contact.h"
+#include "core/frame.h"
+#include "io/rig_description.h"
+
+namespace everytouch::io {
+
+inline constexpr const char* kRecordingFormat = "everytouch-recording";
+inline constexpr int kRecordingVersion = 1;
+
+struct FrameEntry {
+    std::uint64_t index = 0;
+    std::int64_t timestampUs = 0;
+    core::Polarity polarity = core::Polarity::Positive;
+};
+
+// A recording directory (architecture.md, "Recording"). Opening checks every file it names, so a recording
+// either opens completely or not at all; frame images are read on demand.
+class Recording {
+public:
+    // Throws InputError naming the file and the field or line at fault.
+    static Recording open(const std::filesystem::path& directory);
+
+    const RigDescription& rig() const { return rig_; }
+    const std::vector<FrameEntry>& frames() const { return frames_; }
+    const std::vector<core::FingerTruth>& truth() const { return truth_; }  // empty without truth.csv
+    bool hasTruth() const { return hasTruth_; }
+
+    // Reads frame number `position` (0 .. frames().size()-1); throws InputError if the image is unreadable or
+    // does not match camera_size.
+    core::Frame loadFrame(std::size_t position) const;
+
+    static std::filesystem::path framePath(const std::filesystem::path& directory, std::uint64_t index);
+
+private:
+    std::filesystem::path directory_;
+    RigDescription rig_;
+    std::vector<FrameEntry> frames_;
+    std::vector<core::FingerTruth> truth_;
+    bool hasTruth_ = false;
+};
+
+// Writes a recording directory from any rig. The directory must not exist or be empty.
+class RecordingWriter {
+public:
+    RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig, bool withTruth);
+
+    void addFrame(const core::Frame& frame);
+    void addTruth(const std::vector<core::FingerTruth>& fingers);
+    void flush();
+
+private:
+    std::filesystem::path directory_;
+    std::ofstream framesCsv_;
+    std::ofstream truthCsv_;
+};
+
+}  // namespace everytouch::io

@@ -1,0 +1,25 @@
+#include "io/replay_source.h"
+
+#include <thread>
+
+namespace everytouch::io {
+
+ReplaySource::ReplaySource(const std::filesystem::path& directory, bool paced)
+    : directory_(directory), recording_(Recording::open(directory)), paced_(paced) {}
+
+std::optional<core::Frame> ReplaySource::next() {
+    if (position_ >= recording_.frames().size())
+        return std::nullopt;
+    core::Frame frame = recording_.loadFrame(position_);
+    if (paced_) {
+        if (position_ == 0)
+            start_ = std::chrono::steady_clock::now();
+        const auto offset =
+            std::chrono::microseconds(frame.timestampUs - recording_.frames().front().timestampUs);
+        std::this_thread::sleep_until(start_ + offset);
+    }
+    ++position_;
+    return frame;
+}
+
+}  // namespace everytouch::io

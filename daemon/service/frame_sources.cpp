@@ -1,0 +1,24 @@
+#include "service/frame_sources.h"
+
+#include "io/input_error.h"
+#include "io/replay_source.h"
+
+namespace everytouch::service {
+
+std::unique_ptr<io::FrameSource> openFrameSource(const io::RigSpec& spec, bool fast) {
+    switch (spec.kind) {
+        case io::RigSpec::Kind::Replay:
+            return std::make_unique<io::ReplaySource>(spec.target, !fast);
+        case io::RigSpec::Kind::Sim:
+            throw io::InputError(
+                "--rig " + spec.toString(), "",
+                "the simulated rig is not part of this build yet; use replay:DIR with a recording");
+        case io::RigSpec::Kind::Aravis:
+        case io::RigSpec::Kind::V4l2:
+            throw io::InputError("--rig " + spec.toString(), "",
+                                 "camera rigs are not part of this build yet");
+    }
+    throw io::InputError("--rig " + spec.toString(), "", "unknown rig kind");
+}
+
+}  // namespace everytouch::service

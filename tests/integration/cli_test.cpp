@@ -1,0 +1,86 @@
+// Runs the real everytouchd and everytouch-calib binaries.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/recording.h"
+#include "io/touch_log.h"
+#include "support/process.h"
+#include "support/temp_dir.h"
+#include "support/test_rig.h"
+
+namespace everytouch {
+namespace {
+
+using ::testing::HasSubstr;
+
+TEST(Everytouchd, HelpListsEveryOption) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--help"});
+    EXPECT_EQ(result.exitCode, 0);
+    for (const char* option :
+         {"--config", "--rig", "--log", "--record", "--frames", "--fast", "--verbose", "--version"})
+        EXPECT_THAT(result.out, HasSubstr(option));
+}
+
+TEST(Everytouchd, VersionPrintsNameAndVersion) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--version"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.out, HasSubstr("everytouchd 0."));
+}
+
+TEST(Everytouchd, BadRigIsAUsageErrorNamingTheOption) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--rig", "webcam"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("--rig webcam"));
+}
+
+TEST(Everytouchd, MissingRecordingIsReportedByPath) {
+    test::TempDir dir;
+    const test::ProcessResult result =
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "replay:" + (dir / "absent").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("absent"));
+}
+
+TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
+    test::TempDir dir;
+    const io::RigDescription rig = test::paperLikeRig();
+    {
+        io::RecordingWriter writer(dir / "in", rig, false);
+        for (std::uint64_t i = 0; i < 6; ++i) {
+            core::Frame frame;
+            frame.index = i;
+            frame.timestampUs = static_cast<std::int64_t>(i) * 8333;
+            frame.polarity = i % 2 ? core::Polarity::Negative : core::Polarity::Positive;
+            frame.image =
+                cv::Mat(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(static_cast<double>(40 * i)));
+            writer.addFrame(frame);
+        }
+    }
+    const test::ProcessResult result = test::runProcess(
+        {EVERYTOUCHD_PATH, "--rig", "replay:" + (dir / "in").string(), "--fast", "--frames", "5", "--record",
+         (dir / "out").string(), "--log", (dir / "touches.jsonl").string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.err, HasSubstr("processed 5 frames (4 pairs)"));
+    const io::Recording again = io::Recording::open(dir / "out");
+    EXPECT_EQ(again.frames().size(), 5u);
+    EXPECT_EQ(cv::norm(again.loadFrame(4).image,
+                       cv::Mat(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(160)), cv::NORM_INF),
+              0.0);
+    EXPECT_TRUE(io::readTouchLog(dir / "touches.jsonl").empty());
+}
+
+TEST(EverytouchCalib, HelpDocumentsExitCodes) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "--help"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.out, HasSubstr("Exit status"));
+    EXPECT_THAT(result.out, HasSubstr("status"));
+}
+
+TEST(EverytouchCalib, VersionPrintsNameAndVersion) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "--version"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.out, HasSubstr("everytouch-calib 0."));
+}
+
+}  // namespace
+}  // namespace everytouch

@@ -1,0 +1,137 @@
+#include "io/calibration_file.h"
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/input_error.h"
+#include "support/temp_dir.h"
+#include "support/test_rig.h"
+
+namespace everytouch::io {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+std::string readText(const std::filesystem::path& path) {
+    std::ifstream input(path);
+    std::stringstream text;
+    text << input.rdbuf();
+    return text.str();
+}
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream(path) << text;
+}
+
+class CalibrationFileTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        writeCalibrationFile(good_, test::paperLikeCalibration());
+        goodText_ = readText(good_);
+    }
+
+    // Writes the good file with `pattern` replaced by `replacement` and returns the reader's complaint.
+    std::string complaintAfter(const std::string& pattern, const std::string& replacement) {
+        const std::string bad = std::regex_replace(goodText_, std::regex(pattern), replacement,
+                                                   std::regex_constants::format_first_only);
+        EXPECT_NE(bad, goodText_) << "pattern " << pattern << " did not match";
+        writeText(badPath_, bad);
+        try {
+            readCalibrationFile(badPath_);
+        } catch (const InputError& error) {
+            return error.what();
+        }
+        ADD_FAILURE() << "accepted a file with " << pattern << " -> " << replacement;
+        return {};
+    }
+
+    test::TempDir dir_;
+    std::filesystem::path good_ = dir_ / "calibration.yml";
+    std::filesystem::path badPath_ = dir_ / "bad.yml";
+    std::string goodText_;
+};
+
+TEST_F(CalibrationFileTest, RoundTripKeepsEveryValue) {
+    const core::Calibration original = test::paperLikeCalibration();
+    const core::Calibration read = readCalibrationFile(good_);
+    EXPECT_EQ(read.cameraSize, original.cameraSize);
+    EXPECT_EQ(read.projectorSize, original.projectorSize);
+    EXPECT_EQ(read.displaySize, original.displaySize);
+    EXPECT_TRUE(read.cameraMatrix.isApprox(original.cameraMatrix, 1e-15));
+    EXPECT_TRUE(read.projectorMatrix.isApprox(original.projectorMatrix, 1e-15));
+    EXPECT_TRUE(read.tableToCamera.matrix().isApprox(original.tableToCamera.matrix(), 1e-15));
+    EXPECT_TRUE(read.tableToProjector.matrix().isApprox(original.tableToProjector.matrix(), 1e-15));
+    EXPECT_TRUE(read.displayToProjector.isApprox(original.displayToProjector, 1e-15));
+    EXPECT_EQ(read.cameraDistortion, original.cameraDistortion);
+}
+
+TEST_F(CalibrationFileTest, FileStartsWithFormatAndVersion) {
+    EXPECT_THAT(goodText_, HasSubstr("format: everytouch-calibration"));
+    EXPECT_THAT(goodText_, HasSubstr("version: 1"));
+}
+
+TEST_F(CalibrationFileTest, RejectsMissingKey) {
+    EXPECT_THAT(complaintAfter("projector_matrix:", "projector_matrx:"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("projector_matrix"), HasSubstr("missing")));
+}
+
+TEST_F(CalibrationFileTest, RejectsWrongMatrixSize) {
+    EXPECT_THAT(complaintAfter("(camera_matrix: !!opencv-matrix\\s+rows: )3", "$012"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("camera_matrix")));
+}
+
+TEST_F(CalibrationFileTest, RejectsNonFiniteNumber) {
+    EXPECT_THAT(complaintAfter("(table_to_camera: !!opencv-matrix[^\\[]+\\[\\s*)[-0-9.e+]+", "$01.nan"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("table_to_camera"), HasSubstr("finite")));
+}
+
+TEST_F(CalibrationFileTest, RejectsWrongVersion) {
+    EXPECT_THAT(complaintAfter("version: 1", "version: 2"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("version")));
+}
+
+TEST_F(CalibrationFileTest, RejectsWrongFormat) {
+    EXPECT_THAT(complaintAfter("format: everytouch-calibration", "format: something-else"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("format")));
+}
+
+TEST_F(CalibrationFileTest, RejectsSizeThatIsNotTwoPositiveIntegers) {
+    EXPECT_THAT(complaintAfter("camera_size: \\[ 648, 488 \\]", "camera_size: [ 648 ]"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("camera_size")));
+    EXPECT_THAT(complaintAfter("display_size: \\[ 1280, 960 \\]", "display_size: [ 1280, -960 ]"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("display_size")));
+}
+
+TEST_F(CalibrationFileTest, RejectsTransformThatIsNotRigid) {
+    EXPECT_THAT(complaintAfter("(table_to_projector: !!opencv-matrix[^\\[]+\\[\\s*)[-0-9.e+]+", "$012.5"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("table_to_projector"), HasSubstr("rotation")));
+}
+
+TEST_F(CalibrationFileTest, RejectsTruncatedFile) {
+    writeText(badPath_, goodText_.substr(0, goodText_.size() / 2));
+    EXPECT_THROW(readCalibrationFile(badPath_), InputError);
+}
+
+TEST_F(CalibrationFileTest, RejectsGarbageAndMissingFile) {
+    writeText(badPath_, "{{{ this is : not [ yaml");
+    EXPECT_THROW(readCalibrationFile(badPath_), InputError);
+    EXPECT_THAT([&] { readCalibrationFile(dir_ / "nowhere.yml"); },
+                ::testing::ThrowsMessage<InputError>(HasSubstr("nowhere.yml")));
+}
+
+TEST_F(CalibrationFileTest, FailedWriteLeavesTheOldFileIntact) {
+    core::Calibration broken = test::paperLikeCalibration();
+    broken.cameraMatrix(1, 1) = 0;
+    EXPECT_THROW(writeCalibrationFile(good_, broken), InputError);
+    EXPECT_EQ(readText(good_), goodText_);
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_.path()), {}), 1)
+        << "a temporary file was left";
+}
+
+}  // namespace
+}  // namespace everytouch::io

@@ -1,0 +1,174 @@
+#include "io/recording.h"
+
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "io/input_error.h"
+#include "support/temp_dir.h"
+#include "support/test_rig.h"
+
+namespace everytouch::io {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+std::string readText(const std::filesystem::path& path) {
+    std::ifstream input(path);
+    std::stringstream text;
+    text << input.rdbuf();
+    return text.str();
+}
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream(path) << text;
+}
+
+core::Frame makeFrame(std::uint64_t index, const cv::Size& size) {
+    core::Frame frame;
+    frame.index = index;
+    frame.timestampUs = 1000 + static_cast<std::int64_t>(index) * 8333;
+    frame.polarity = index % 2 == 0 ? core::Polarity::Positive : core::Polarity::Negative;
+    frame.image.create(size, CV_8UC3);
+    cv::randu(frame.image, 0, 256);
+    return frame;
+}
+
+class RecordingTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        rig_ = test::paperLikeRig();
+        RecordingWriter writer(dir_.path(), rig_, true);
+        for (std::uint64_t i = 0; i < 4; ++i) {
+            frames_.push_back(makeFrame(i, rig_.calibration.cameraSize));
+            writer.addFrame(frames_.back());
+            writer.addTruth({{i, 7, 100.5 + i, 200.25, i == 3 ? 0.0 : 4.5}});
+        }
+        writer.flush();
+    }
+
+    std::string complaint() {
+        try {
+            Recording::open(dir_.path());
+        } catch (const InputError& error) {
+            return error.what();
+        }
+        ADD_FAILURE() << "the recording was accepted";
+        return {};
+    }
+
+    // Replaces the first match of `pattern` in the recording's `file`.
+    void edit(const std::string& file, const std::string& pattern, const std::string& replacement) {
+        const std::string before = readText(dir_ / file);
+        const std::string after = std::regex_replace(before, std::regex(pattern), replacement,
+                                                     std::regex_constants::format_first_only);
+        ASSERT_NE(before, after) << pattern;
+        writeText(dir_ / file, after);
+    }
+
+    test::TempDir dir_;
+    RigDescription rig_;
+    std::vector<core::Frame> frames_;
+};
+
+TEST_F(RecordingTest, RoundTripGivesBackRigFramesAndTruth) {
+    const Recording recording = Recording::open(dir_.path());
+    EXPECT_EQ(recording.rig().delta, rig_.delta);
+    EXPECT_EQ(recording.rig().frameRate, rig_.frameRate);
+    EXPECT_EQ(cv::countNonZero(recording.rig().pattern != rig_.pattern), 0);
+    EXPECT_TRUE(recording.rig().calibration.cameraMatrix.isApprox(rig_.calibration.cameraMatrix));
+    ASSERT_EQ(recording.frames().size(), 4u);
+    for (std::size_t i = 0; i < 4; ++i) {
+        const core::Frame frame = recording.loadFrame(i);
+        EXPECT_EQ(frame.index, frames_[i].index);
+        EXPECT_EQ(frame.timestampUs, frames_[i].timestampUs);
+        EXPECT_EQ(frame.polarity, frames_[i].polarity);
+        EXPECT_EQ(cv::norm(frame.image, frames_[i].image, cv::NORM_INF), 0.0) << "frames must be lossless";
+    }
+    ASSERT_TRUE(recording.hasTruth());
+    ASSERT_EQ(recording.truth().size(), 4u);
+    EXPECT_EQ(recording.truth()[1], (core::FingerTruth{1, 7, 101.5, 200.25, 4.5}));
+    EXPECT_EQ(recording.truth()[3].heightMm, 0.0);
+}
+
+TEST_F(RecordingTest, PatternFileUses0And255) {
+    const cv::Mat pattern = cv::imread((dir_ / "pattern.png").string(), cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(pattern.type(), CV_8UC1);
+    EXPECT_EQ(cv::countNonZero(pattern == 0) + cv::countNonZero(pattern == 255),
+              static_cast<int>(pattern.total()));
+}
+
+TEST_F(RecordingTest, WriterRefusesANonEmptyDirectory) {
+    EXPECT_THROW(RecordingWriter(dir_.path(), rig_, false), InputError);
+}
+
+TEST_F(RecordingTest, RejectsPolarityOtherThanPlusOrMinusOne) {
+    edit("frames.csv", ",-1\n", ",0\n");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("frames.csv"), HasSubstr("line 3"), HasSubstr("polarity")));
+}
+
+TEST_F(RecordingTest, RejectsMissingFrameFile) {
+    std::filesystem::remove(Recording::framePath(dir_.path(), 2));
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("000002.png"), HasSubstr("missing")));
+}
+
+TEST_F(RecordingTest, RejectsTruncatedFramesLine) {
+    const std::string text = readText(dir_ / "frames.csv");
+    writeText(dir_ / "frames.csv", text.substr(0, text.size() - 4));
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("frames.csv"), HasSubstr("line 5")));
+}
+
+TEST_F(RecordingTest, RejectsTruncatedTruthLine) {
+    edit("truth.csv", "\n2,7,[^\n]*\n", "\n2,7,102.5\n");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("truth.csv"), HasSubstr("line 4"), HasSubstr("truncated")));
+}
+
+TEST_F(RecordingTest, RejectsNegativeOrNonFiniteTruth) {
+    edit("truth.csv", "4\\.500\n", "-1\n");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("truth.csv"), HasSubstr("height_mm")));
+    edit("truth.csv", "-1\n", "nan\n");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("truth.csv"), HasSubstr("height_mm")));
+}
+
+TEST_F(RecordingTest, RejectsWrongHeader) {
+    edit("frames.csv", "timestamp_us", "time");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("frames.csv"), HasSubstr("header")));
+}
+
+TEST_F(RecordingTest, RejectsMissingRigKey) {
+    edit("rig.yml", "delta:", "deltas:");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("rig.yml"), HasSubstr("delta"), HasSubstr("missing")));
+}
+
+TEST_F(RecordingTest, RejectsWrongVersion) {
+    edit("rig.yml", "version: 1", "version: 7");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("rig.yml"), HasSubstr("version")));
+}
+
+TEST_F(RecordingTest, RejectsBadCalibrationInRig) {
+    edit("rig.yml", "(projector_matrix: !!opencv-matrix\\s+rows: 3\\s+cols: )3", "$012");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("rig.yml"), HasSubstr("projector_matrix")));
+}
+
+TEST_F(RecordingTest, RejectsPatternOfWrongSizeOrValues) {
+    cv::imwrite((dir_ / "pattern.png").string(), cv::Mat(100, 100, CV_8UC1, cv::Scalar(255)));
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("pattern.png"), HasSubstr("projector size")));
+    cv::imwrite((dir_ / "pattern.png").string(),
+                cv::Mat(rig_.calibration.projectorSize, CV_8UC1, cv::Scalar(128)));
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("pattern.png"), HasSubstr("0 and 255")));
+}
+
+TEST_F(RecordingTest, FrameOfWrongSizeIsRejectedWhenRead) {
+    cv::imwrite(Recording::framePath(dir_.path(), 1).string(), cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)));
+    const Recording recording = Recording::open(dir_.path());
+    EXPECT_THAT([&] { recording.loadFrame(1); },
+                ::testing::ThrowsMessage<InputError>(HasSubstr("000001.png")));
+}
+
+}  // namespace
+}  // namespace everytouch::io

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The developer's entry point (README "Quick start"):
+#   tools/dev.sh run [everytouchd options]   install what is missing, build, run the daemon on the simulated rig
+#   tools/dev.sh test                          install what is missing, build, run the whole test suite
+#   tools/dev.sh sanitize                      the test suite again, built with AddressSanitizer + UBSan
+#   tools/dev.sh format                        apply clang-format to every C++ file (format-check: only report)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+# Debian 12 packages the build, the tests and the VM harness need.
+packages=(
+    build-essential cmake pkg-config clang-format
+    libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
+    libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools
+    libcli11-dev nlohmann-json3-dev
+    dbus systemd udev
+)
+
+jobs=$(nproc)
+
+install_missing_packages() {
+    local missing=()
+    for package in "${packages[@]}"; do
+        dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+    done
+    [ ${#missing[@]} -eq 0 ] && return
+    echo "Installing ${missing[*]}"
+    local sudo=()
+    [ "$(id -u)" -eq 0 ] || sudo=(sudo)
+    "${sudo[@]}" apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+# build DIR [cmake options...]
+build() {
+    local dir=$1
+    shift
+    local werror=OFF
+    [ "${CI:-}" = "true" ] && werror=ON
+    cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEVERYTOUCH_WERROR="$werror" "$@" >/dev/null
+    cmake --build "$dir" -j "$jobs"
+}
+
+cpp_files() { git ls-files '*.cpp' '*.h' ; }
+
+command=${1:-}
+[ $# -gt 0 ] && shift
+case "$command" in
+run)
+    install_missing_packages
+    build build
+    exec build/daemon/everytouchd --rig sim:demo --fast --log touches.jsonl "$@"
+    ;;
+test)
+    install_missing_packages
+    build build
+    ctest --test-dir build --output-on-failure -j "$jobs" "$@"
+    ;;
+sanitize)
+    install_missing_packages
+    build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF
+    ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+        ctest --test-dir build-sanitize --output-on-failure -j "$jobs" "$@"
+    ;;
+format)
+    cpp_files | xargs clang-format -i
+    ;;
+format-check)
+    cpp_files | xargs clang-format --dry-run -Werror
+    ;;
+*)
+    sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'
+    exit 2
+    ;;
+esac
