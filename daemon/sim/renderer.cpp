@@ -1,0 +1,549 @@
+#include "sim/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/embedding.h"
+#include "core/geometry.h"
+
+namespace everytouch::sim {
+
+namespace {
+
+constexpr float kNoHit = std::numeric_limits<float>::infinity();
+constexpr float kShadowBiasMm = 2.0f;  // a surface point is shadowed by hand parts at least this much nearer
+constexpr double kTexelMm = 0.4;       // resolution of the table's albedo map
+
+// Linear reflectance (R, G, B) of skin tones and of finger nails over them.
+Eigen::Vector3f skinReflectance(SkinTone tone) {
+    switch (tone) {
+        case SkinTone::Light:
+            return {0.62f, 0.45f, 0.36f};
+        case SkinTone::Medium:
+            return {0.50f, 0.34f, 0.25f};
+        case SkinTone::Tan:
+            return {0.38f, 0.25f, 0.16f};
+        case SkinTone::Dark:
+            return {0.20f, 0.12f, 0.08f};
+    }
+    return {0.5f, 0.34f, 0.25f};
+}
+
+Eigen::Vector3f toBgr(const Eigen::Vector3f& rgb) {
+    return {rgb.z(), rgb.y(), rgb.x()};
+}
+
+// Bilinear sample of a float image with `channels` channels; false outside.
+template <int channels>
+bool sampleBilinear(const cv::Mat& image, float x, float y, float* out) {
+    if (!(x >= 0.0f && y >= 0.0f && x <= image.cols - 1.001f && y <= image.rows - 1.001f))
+        return false;
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    const float fx = x - x0, fy = y - y0;
+    const float* row0 = image.ptr<float>(y0) + x0 * channels;
+    const float* row1 = image.ptr<float>(y0 + 1) + x0 * channels;
+    for (int c = 0; c < channels; ++c) {
+        const float top = row0[c] + (row0[c + channels] - row0[c]) * fx;
+        const float bottom = row1[c] + (row1[c + channels] - row1[c]) * fx;
+        out[c] = top + (bottom - top) * fy;
+    }
+    return true;
+}
+
+// Image region containing a capsule: the union of the discs its two end spheres project to (a sphere swept
+// along the axis stays inside their convex hull). Conservative for off-axis spheres, whose images stretch.
+cv::Rect capsuleBox(const Capsule& capsule, const Eigen::Matrix3d& intrinsics, const Eigen::Isometry3d& tableToDevice,
+                    cv::Size image) {
+    const double radius = capsule.axes.colwise().norm().maxCoeff();
+    const double focal = std::max(intrinsics(0, 0), intrinsics(1, 1));
+    double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+    for (const Eigen::Vector3d& centre : {capsule.origin, capsule.axisEnd()}) {
+        const Eigen::Vector3d inDevice = tableToDevice * centre;
+        if (inDevice.z() - radius < 1.0)
+            return cv::Rect(0, 0, image.width, image.height);
+        const Eigen::Vector3d q = intrinsics * inDevice;
+        const double reach = 1.2 * radius * focal / (inDevice.z() - radius) + 1.0;
+        minX = std::min(minX, q.x() / q.z() - reach), maxX = std::max(maxX, q.x() / q.z() + reach);
+        minY = std::min(minY, q.y() / q.z() - reach), maxY = std::max(maxY, q.y() / q.z() + reach);
+    }
+    const cv::Rect box(static_cast<int>(std::floor(minX)), static_cast<int>(std::floor(minY)),
+                       static_cast<int>(std::ceil(maxX - minX)) + 2, static_cast<int>(std::ceil(maxY - minY)) + 2);
+    return box & cv::Rect(0, 0, image.width, image.height);
+}
+
+double jacobianScale(const Eigen::Matrix3d& homography, const Eigen::Vector2d& at) {
+    const double step = 0.5;
+    const Eigen::Vector2d dx = core::applyHomography(homography, at + Eigen::Vector2d(step, 0)) -
+                               core::applyHomography(homography, at - Eigen::Vector2d(step, 0));
+    const Eigen::Vector2d dy = core::applyHomography(homography, at + Eigen::Vector2d(0, step)) -
+                               core::applyHomography(homography, at - Eigen::Vector2d(0, step));
+    return std::sqrt(std::abs(dx.x() * dy.y() - dx.y() * dy.x())) / (2 * step);
+}
+
+void blurIfNeeded(const cv::Mat& in, cv::Mat& out, double sigma) {
+    if (sigma > 0.05) {
+        const int reach = static_cast<int>(std::ceil(3.0 * sigma));
+        cv::GaussianBlur(in, out, {2 * reach + 1, 2 * reach + 1}, sigma, sigma, cv::BORDER_REPLICATE);
+    } else {
+        in.copyTo(out);
+    }
+}
+
+cv::Mat toCv(const Eigen::Matrix3d& m) {
+    cv::Mat out(3, 3, CV_64F);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            out.at<double>(r, c) = m(r, c);
+    return out;
+}
+
+}  // namespace
+
+struct Renderer::PreparedCapsule {
+    CapsuleHit camera;
+    CapsuleHit projector;
+    Eigen::Matrix3f cameraPixelToLocal;     // (u, v, 1) -> local direction
+    Eigen::Matrix3f projectorPixelToLocal;
+    cv::Rect cameraBox, projectorBox;
+    HandPart part;
+    float length;
+};
+
+Renderer::Renderer(const SimParameters& parameters, const core::Calibration& calibration, const cv::Mat& pattern)
+    : parameters_(parameters), calibration_(calibration), pattern_(pattern.clone()), sensor_(parameters, calibration) {
+    CV_Assert(pattern.type() == CV_8UC1 && pattern.size() == calibration.projectorSize);
+    const SimParameters& p = parameters_;
+    const cv::Size cameraSize = calibration.cameraSize, panelSize = calibration.projectorSize;
+    cameraCentre_ = calibration.tableToCamera.inverse().translation();
+    projectorCentre_ = calibration.tableToProjector.inverse().translation();
+    cameraPixelToRay_ = calibration.tableToCamera.rotation().transpose() * calibration.cameraMatrix.inverse();
+    projectorPixelToRay_ = calibration.tableToProjector.rotation().transpose() * calibration.projectorMatrix.inverse();
+    projectorProjection_ = (calibration.projectorMatrix * calibration.tableToProjector.rotation()).cast<float>();
+    projectorTranslation_ = (calibration.projectorMatrix * calibration.tableToProjector.translation()).cast<float>();
+    cameraToProjector_ = calibration.cameraToProjectorHomography(0.0);
+    projectorToCamera_ = cameraToProjector_.inverse();
+
+    const Eigen::Matrix3d displayToTable = calibration.displayToTableHomography();
+    const Eigen::Vector2d centre = core::applyHomography(
+        displayToTable, {calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0});
+    referenceDistance2_ = (projectorCentre_ - Eigen::Vector3d(centre.x(), centre.y(), 0)).squaredNorm();
+    referenceCosine_ = projectorCentre_.z() / std::sqrt(referenceDistance2_);
+
+    // Panel vignetting: quadratic in the distance from the panel centre, `projectorCornerFalloff` at corners.
+    panelFalloff_.create(panelSize, CV_32FC3);
+    const double halfW = (panelSize.width - 1) / 2.0, halfH = (panelSize.height - 1) / 2.0;
+    for (int y = 0; y < panelSize.height; ++y)
+        for (int x = 0; x < panelSize.width; ++x) {
+            const double r2 = ((x - halfW) * (x - halfW) + (y - halfH) * (y - halfH)) /
+                              (halfW * halfW + halfH * halfH);
+            panelFalloff_.at<cv::Vec3f>(y, x) = cv::Vec3f::all(static_cast<float>(1.0 - (1.0 - p.projectorCornerFalloff) * r2));
+        }
+
+    // The table seen by each camera pixel: albedo integrated over the pixel, and the projector's light falloff.
+    const Eigen::Matrix3d cameraToTable = calibration.tableToCameraHomography().inverse();
+    double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(cameraSize.width, 0),
+                                          Eigen::Vector2d(0, cameraSize.height),
+                                          Eigen::Vector2d(cameraSize.width, cameraSize.height)}) {
+        const Eigen::Vector2d table = core::applyHomography(cameraToTable, corner);
+        minX = std::min(minX, table.x()), maxX = std::max(maxX, table.x());
+        minY = std::min(minY, table.y()), maxY = std::max(maxY, table.y());
+    }
+    const double margin = 10.0;
+    const SurfaceTexture surface = makeSurface(
+        p.surface, cv::Rect2d(minX - margin, minY - margin, maxX - minX + 2 * margin, maxY - minY + 2 * margin),
+        kTexelMm, p.seed);
+    const int n = p.pixelSamples;
+    albedo_ = cv::Mat::zeros(cameraSize, CV_32FC3);
+    cv::Mat sample;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
+            offset(0, 2) = (i + 0.5) / n - 0.5, offset(1, 2) = (j + 0.5) / n - 0.5;
+            cv::warpPerspective(surface.albedo, sample, toCv(surface.tableToTexel * cameraToTable * offset), cameraSize,
+                                cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+            cv::accumulate(sample, albedo_);
+        }
+    albedo_ /= 255.0 * n * n;
+    tableIncidence_.create(cameraSize, CV_32FC1);
+    for (int y = 0; y < cameraSize.height; ++y)
+        for (int x = 0; x < cameraSize.width; ++x) {
+            const Eigen::Vector2d table = core::applyHomography(cameraToTable, {x, y});
+            const double r2 = (projectorCentre_ - Eigen::Vector3d(table.x(), table.y(), 0)).squaredNorm();
+            const double cosine = projectorCentre_.z() / std::sqrt(r2);
+            tableIncidence_.at<float>(y, x) = static_cast<float>(referenceDistance2_ / r2 * cosine / referenceCosine_);
+        }
+    const Eigen::Vector3f ambient = toBgr(p.ambientColour.cast<float>());
+    ambientBgr_ = ambient;
+    ambientTerm_ = albedo_.mul(cv::Scalar(ambient.x(), ambient.y(), ambient.z()));
+    blurIfNeeded(ambientTerm_, ambientBlurred_, p.cameraDefocusPx);
+
+    const Eigen::Vector3f skin = skinReflectance(p.skinTone);
+    skinBgr_ = toBgr(skin);
+    nailBgr_ = toBgr(Eigen::Vector3f(0.5f * skin + Eigen::Vector3f(0.30f, 0.24f, 0.24f)));
+
+    shadowDepth_ = cv::Mat(panelSize, CV_32FC1, cv::Scalar(kNoHit));
+    shadowMask_ = cv::Mat::zeros(panelSize, CV_32FC1);
+    depth_ = cv::Mat(cameraSize, CV_32FC1, cv::Scalar(kNoHit));
+    hitIndex_ = cv::Mat(cameraSize, CV_16SC1, cv::Scalar(-1));
+}
+
+double Renderer::meterExposureMs(double ambientLux) const {
+    const cv::Scalar albedo = cv::mean(albedo_);
+    const Eigen::Vector3f& ambient = ambientBgr_;
+    double dnPerMs = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        const double radiance = albedo[c] * (parameters_.projectorWhiteLux + ambientLux * ambient[c]);
+        dnPerMs = std::max(dnPerMs, radiance * sensor_.dnPerLux(c, 1.0));
+    }
+    if (dnPerMs <= 0.0)
+        return parameters_.maxExposureMs;
+    const double target = parameters_.autoExposureLevel * (255.0 - sensor_.blackLevelDn());
+    return std::min(parameters_.maxExposureMs, target / dnPerMs);
+}
+
+void Renderer::setContent(const cv::Mat& displayContent) {
+    CV_Assert(displayContent.type() == CV_8UC3 && displayContent.size() == calibration_.displaySize);
+    const SimParameters& p = parameters_;
+    const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
+    cv::Mat panelContent, images[2];
+    cv::warpPerspective(displayContent, panelContent, toCv(calibration_.displayToProjector), panelSize, cv::INTER_LINEAR,
+                        cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    core::embedCode(panelContent, pattern_, p.delta, images[0], images[1]);
+
+    // Projector transfer: digital level -> light, as a fraction of white.
+    cv::Mat transfer(1, 256, CV_32F);
+    for (int level = 0; level < 256; ++level)
+        transfer.at<float>(level) = static_cast<float>(
+            p.projectorWhiteLux * (p.projectorBlackLevel +
+                                   (1.0 - p.projectorBlackLevel) * std::pow(level / 255.0, p.projectorGamma)));
+
+    // Blur scales in panel pixels: the camera pixel's footprint (a box, as a Gaussian of equal variance) and the
+    // light's spread inside skin.
+    const Eigen::Vector2d cameraCentre((cameraSize.width - 1) / 2.0, (cameraSize.height - 1) / 2.0);
+    const double footprint = jacobianScale(cameraToProjector_, cameraCentre);
+    const double mmPerPanelPixel =
+        jacobianScale(calibration_.tableToProjectorHomography().inverse(),
+                      core::applyHomography(cameraToProjector_, cameraCentre));
+    const double direct2 = p.projectorDefocusPx * p.projectorDefocusPx + footprint * footprint / 12.0;
+
+    const int n = p.pixelSamples;
+    cv::Mat& light = work_[0];
+    cv::Mat& blurred = work_[1];
+    cv::Mat& sample = work_[2];
+    cv::Mat& accumulated = work_[3];
+    for (int polarity = 0; polarity < 2; ++polarity) {
+        cv::LUT(images[polarity], transfer, light);
+        light = light.mul(panelFalloff_);
+        // The table: projector defocus, then the exact integral over each camera pixel by n x n samples.
+        blurIfNeeded(light, blurred, p.projectorDefocusPx);
+        accumulated = cv::Mat::zeros(cameraSize, CV_32FC3);
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
+                offset(0, 2) = (i + 0.5) / n - 0.5, offset(1, 2) = (j + 0.5) / n - 0.5;
+                cv::warpPerspective(blurred, sample, toCv(cameraToProjector_ * offset), cameraSize,
+                                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+                accumulated += sample;
+            }
+        accumulated *= 1.0 / (n * n);
+        cv::Mat incidence3;
+        cv::merge(std::vector<cv::Mat>{tableIncidence_, tableIncidence_, tableIncidence_}, incidence3);
+        projected_[polarity] = accumulated.mul(albedo_).mul(incidence3);
+        blurIfNeeded(projected_[polarity], projectedBlurred_[polarity], p.cameraDefocusPx);
+
+        // Skin: part of the light is reflected at the surface, the rest leaves after spreading under the skin
+        // (red farthest). Both seen through the camera pixel's footprint.
+        cv::Mat direct;
+        blurIfNeeded(light, direct, std::sqrt(direct2));
+        std::vector<cv::Mat> channels(3);
+        cv::split(light, channels);
+        const Eigen::Vector3d scatterBgr(p.skinScatterMm.z(), p.skinScatterMm.y(), p.skinScatterMm.x());
+        for (int c = 0; c < 3; ++c) {
+            const double spread = scatterBgr[c] / mmPerPanelPixel;
+            blurIfNeeded(channels[c], channels[c], std::sqrt(direct2 + spread * spread));
+        }
+        cv::Mat scattered;
+        cv::merge(channels, scattered);
+        cv::addWeighted(direct, 1.0 - p.skinScatterFraction, scattered, p.skinScatterFraction, 0.0,
+                        skinLight_[polarity]);
+    }
+}
+
+void Renderer::castShadows(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box) {
+    if (shadowBox_.area() > 0) {
+        shadowDepth_(shadowBox_).setTo(kNoHit);
+        shadowMask_(shadowBox_).setTo(0.0f);
+    }
+    shadowBox_ = cv::Rect();
+    if (box.area() == 0)
+        return;
+    for (const PreparedCapsule& capsule : capsules) {
+        const cv::Rect& b = capsule.projectorBox;
+        const Eigen::Vector3f step = capsule.projectorPixelToLocal.col(0);
+        for (int v = b.y; v < b.y + b.height; ++v) {
+            float* depth = shadowDepth_.ptr<float>(v);
+            Eigen::Vector3f local = capsule.projectorPixelToLocal * Eigen::Vector3f(b.x, v, 1.0f);
+            bool inside = false;
+            for (int u = b.x; u < b.x + b.width; ++u, local += step) {
+                const float t = capsule.projector.intersectLocal(local);
+                if (t > 0.0f) {
+                    inside = true;
+                    depth[u] = std::min(depth[u], t);
+                } else if (inside) {
+                    break;  // a capsule's silhouette is convex: each row crosses it once
+                }
+            }
+        }
+    }
+    // The shadow's edge is as soft as the projector's blur.
+    const int reach = static_cast<int>(std::ceil(3.0 * parameters_.projectorDefocusPx)) + 1;
+    shadowBox_ = cv::Rect(box.x - reach, box.y - reach, box.width + 2 * reach, box.height + 2 * reach) &
+                 cv::Rect(0, 0, shadowDepth_.cols, shadowDepth_.rows);
+    for (int v = box.y; v < box.y + box.height; ++v) {
+        const float* depth = shadowDepth_.ptr<float>(v);
+        float* mask = shadowMask_.ptr<float>(v);
+        for (int u = box.x; u < box.x + box.width; ++u)
+            mask[u] = depth[u] < kNoHit ? 1.0f : 0.0f;
+    }
+    if (parameters_.projectorDefocusPx > 0.05) {
+        cv::Mat region = shadowMask_(shadowBox_);
+        cv::GaussianBlur(region, region, {0, 0}, parameters_.projectorDefocusPx);
+    }
+}
+
+cv::Rect Renderer::shadowOnTable(const cv::Rect& projectorBox) const {
+    if (projectorBox.area() == 0)
+        return {};
+    double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+    for (int corner = 0; corner < 4; ++corner) {
+        const Eigen::Vector2d panel(projectorBox.x + ((corner & 1) ? projectorBox.width : 0),
+                                    projectorBox.y + ((corner & 2) ? projectorBox.height : 0));
+        const Eigen::Vector2d camera = core::applyHomography(projectorToCamera_, panel);
+        minX = std::min(minX, camera.x()), maxX = std::max(maxX, camera.x());
+        minY = std::min(minY, camera.y()), maxY = std::max(maxY, camera.y());
+    }
+    return cv::Rect(static_cast<int>(minX) - 2, static_cast<int>(minY) - 2, static_cast<int>(maxX - minX) + 5,
+                    static_cast<int>(maxY - minY) + 5) &
+           cv::Rect(0, 0, calibration_.cameraSize.width, calibration_.cameraSize.height);
+}
+
+void Renderer::shadeTable(const cv::Rect& box, const cv::Mat& projected) {
+    if (box.area() == 0 || shadowBox_.area() == 0)
+        return;
+    // The shadow mask seen through the table plane: camera pixel (x, y) of `box` -> panel pixel of shadowBox_.
+    Eigen::Matrix3d toPanel = Eigen::Matrix3d::Identity(), fromCamera = Eigen::Matrix3d::Identity();
+    toPanel(0, 2) = -shadowBox_.x, toPanel(1, 2) = -shadowBox_.y;
+    fromCamera(0, 2) = box.x, fromCamera(1, 2) = box.y;
+    cv::warpPerspective(shadowMask_(shadowBox_), blockedOnTable_, toCv(toPanel * cameraToProjector_ * fromCamera),
+                        box.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+    for (int y = 0; y < box.height; ++y) {
+        const float* blocked = blockedOnTable_.ptr<float>(y);
+        float* out = radiance_.ptr<float>(box.y + y) + 3 * box.x;
+        const float* lit = projected.ptr<float>(box.y + y) + 3 * box.x;
+        for (int x = 0; x < box.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                out[3 * x + c] -= blocked[x] * lit[3 * x + c];
+    }
+}
+
+void Renderer::shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t, int polarityIndex,
+                        double ambientLux, float* bgr, float& height) const {
+    const Eigen::Vector3f point = cameraCentre_.cast<float>() + t * direction;
+    const Eigen::Vector3f normal = capsule.camera.normal(direction, t);
+    height = point.z();
+    // Albedo: nail on the back of the last bone's outer part, skin elsewhere.
+    Eigen::Vector3f albedo = skinBgr_;
+    if (capsule.part == HandPart::Fingertip && capsule.camera.dorsal(direction, t) > 0.45f &&
+        capsule.camera.axial(direction, t) > 0.35f * capsule.length)
+        albedo = nailBgr_;
+    // Light from the projector pixel that sees the point, unless a hand part is nearer to the projector.
+    Eigen::Vector3f irradiance = Eigen::Vector3f::Zero();
+    const Eigen::Vector3f q = projectorProjection_ * point + projectorTranslation_;
+    const Eigen::Vector3f toProjector = projectorCentre_.cast<float>() - point;
+    const float distance2 = toProjector.squaredNorm();
+    const float cosine = normal.dot(toProjector) / std::sqrt(distance2);
+    if (q.z() > 0.0f && cosine > 0.0f) {
+        const float u = q.x() / q.z(), v = q.y() / q.z();
+        const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
+        const bool inside = iu >= 0 && iv >= 0 && iu < shadowDepth_.cols && iv < shadowDepth_.rows;
+        float light[3];
+        if (inside && shadowDepth_.at<float>(iv, iu) >= q.z() - kShadowBiasMm &&
+            sampleBilinear<3>(skinLight_[polarityIndex], u, v, light)) {
+            const float geometry =
+                static_cast<float>(referenceDistance2_ / referenceCosine_) * cosine / distance2;
+            irradiance = Eigen::Vector3f(light[0], light[1], light[2]) * geometry;
+        }
+    }
+    // Room light from above: the upper hemisphere is brighter than the table's reflection below.
+    irradiance += ambientBgr_ * static_cast<float>(ambientLux) * (0.6f + 0.4f * normal.z());
+    const Eigen::Vector3f radiance = albedo.cwiseProduct(irradiance);
+    bgr[0] = radiance.x(), bgr[1] = radiance.y(), bgr[2] = radiance.z();
+}
+
+void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box, int polarityIndex,
+                         double ambientLux, FrameTruth& truth) {
+    if (box.area() == 0)
+        return;
+    depth_(box).setTo(kNoHit);
+    hitIndex_(box).setTo(-1);
+    for (size_t k = 0; k < capsules.size(); ++k) {
+        const PreparedCapsule& capsule = capsules[k];
+        const cv::Rect& b = capsule.cameraBox;
+        const Eigen::Vector3f step = capsule.cameraPixelToLocal.col(0);
+        for (int y = b.y; y < b.y + b.height; ++y) {
+            float* depth = depth_.ptr<float>(y);
+            short* index = hitIndex_.ptr<short>(y);
+            Eigen::Vector3f local = capsule.cameraPixelToLocal * Eigen::Vector3f(b.x, y, 1.0f);
+            bool inside = false;
+            for (int x = b.x; x < b.x + b.width; ++x, local += step) {
+                const float t = capsule.camera.intersectLocal(local);
+                if (t > 0.0f) {
+                    inside = true;
+                    if (t < depth[x]) {
+                        depth[x] = t;
+                        index[x] = static_cast<short>(k);
+                    }
+                } else if (inside) {
+                    break;  // a capsule's silhouette is convex: each row crosses it once
+                }
+            }
+        }
+    }
+    const Eigen::Matrix3f pixelToRay = cameraPixelToRay_.cast<float>();
+    const int w = box.width, h = box.height;
+    for (int y = box.y; y < box.y + h; ++y) {
+        const short* index = hitIndex_.ptr<short>(y);
+        const short* above = hitIndex_.ptr<short>(std::max(y - 1, box.y));
+        const short* below = hitIndex_.ptr<short>(std::min(y + 1, box.y + h - 1));
+        float* out = radiance_.ptr<float>(y);
+        for (int x = box.x; x < box.x + w; ++x) {
+            const bool hit = index[x] >= 0;
+            const int left = std::max(x - 1, box.x), right = std::min(x + 1, box.x + w - 1);
+            const bool edge = (index[left] >= 0) != hit || (index[right] >= 0) != hit || (above[x] >= 0) != hit ||
+                              (below[x] >= 0) != hit;
+            if (!hit && !edge)
+                continue;
+            int shadeIndex = index[x];
+            float shadeT = depth_.at<float>(y, x);
+            Eigen::Vector3f shadeDirection = pixelToRay * Eigen::Vector3f(x, y, 1.0f);
+            float coverage = hit ? 1.0f : 0.0f;
+            if (edge) {
+                // Integrate the silhouette over the pixel with four samples.
+                int hits = 0;
+                for (int s = 0; s < 4; ++s) {
+                    const Eigen::Vector3f pixel(x + ((s & 1) ? 0.25f : -0.25f), y + ((s & 2) ? 0.25f : -0.25f), 1.0f);
+                    float best = kNoHit;
+                    int bestIndex = -1;
+                    for (size_t k = 0; k < capsules.size(); ++k) {
+                        if (!capsules[k].cameraBox.contains({x, y}))
+                            continue;
+                        const float t = capsules[k].camera.intersectLocal(capsules[k].cameraPixelToLocal * pixel);
+                        if (t > 0.0f && t < best)
+                            best = t, bestIndex = static_cast<int>(k);
+                    }
+                    if (bestIndex < 0)
+                        continue;
+                    ++hits;
+                    if (shadeIndex < 0)
+                        shadeIndex = bestIndex, shadeT = best, shadeDirection = pixelToRay * pixel;
+                }
+                coverage = hits / 4.0f;
+            }
+            if (shadeIndex < 0 || coverage <= 0.0f)
+                continue;
+            float colour[3];
+            float height = 0.0f;
+            shadeHit(capsules[shadeIndex], shadeDirection, shadeT, polarityIndex, ambientLux, colour, height);
+            for (int c = 0; c < 3; ++c)
+                out[3 * x + c] = coverage * colour[c] + (1.0f - coverage) * out[3 * x + c];
+            if (hit) {
+                truth.handMask.at<uchar>(y, x) = 255;
+                truth.visibleHeightMm.at<float>(y, x) = height;
+            }
+        }
+    }
+}
+
+void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarity, double ambientLux, double exposureMs,
+                      std::uint64_t noiseSeed, cv::Mat& image, FrameTruth& truth) {
+    CV_Assert(!projected_[0].empty());
+    const int polarityIndex = polarity == core::Polarity::Positive ? 0 : 1;
+    const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
+    truth.handMask.create(cameraSize, CV_8UC1);
+    truth.handMask.setTo(0);
+    truth.visibleHeightMm.create(cameraSize, CV_32FC1);
+    truth.visibleHeightMm.setTo(0.0f);
+    truth.fingertips.clear();
+    truth.ambientLux = ambientLux;
+    truth.exposureMs = exposureMs;
+
+    std::vector<PreparedCapsule> capsules;
+    cv::Rect cameraBox, projectorBox;
+    const Eigen::Matrix3f cameraPixelToRay = cameraPixelToRay_.cast<float>();
+    const Eigen::Matrix3f projectorPixelToRay = projectorPixelToRay_.cast<float>();
+    const Eigen::Matrix3d displayFromTable = calibration_.displayToTableHomography().inverse();
+    const Eigen::Matrix3d tableToCamera = calibration_.tableToCameraHomography();
+    for (size_t h = 0; h < hands.size(); ++h) {
+        const HandModel model = buildHand(hands[h]);
+        for (const HandCapsule& part : model.capsules) {
+            PreparedCapsule capsule{CapsuleHit(part.shape, cameraCentre_),
+                                    CapsuleHit(part.shape, projectorCentre_),
+                                    Eigen::Matrix3f(),
+                                    Eigen::Matrix3f(),
+                                    capsuleBox(part.shape, calibration_.cameraMatrix, calibration_.tableToCamera,
+                                               cameraSize),
+                                    capsuleBox(part.shape, calibration_.projectorMatrix,
+                                               calibration_.tableToProjector, panelSize),
+                                    part.part,
+                                    static_cast<float>(part.shape.length)};
+            capsule.cameraPixelToLocal = capsule.camera.toLocal() * cameraPixelToRay;
+            capsule.projectorPixelToLocal = capsule.projector.toLocal() * projectorPixelToRay;
+            cameraBox |= capsule.cameraBox;
+            projectorBox |= capsule.projectorBox;
+            capsules.push_back(std::move(capsule));
+        }
+        for (int f = 0; f < kFingerCount; ++f) {
+            FingertipTruth tip;
+            tip.hand = static_cast<int>(h);
+            tip.finger = static_cast<Finger>(f);
+            tip.id = static_cast<std::uint32_t>(h * kFingerCount + f);
+            tip.pad = model.pads[f];
+            tip.heightMm = tip.pad.z() < kContactToleranceMm ? 0.0 : tip.pad.z();
+            tip.touching = tip.heightMm == 0.0;
+            tip.presented = hands[h].presented[f];
+            const Eigen::Vector2d display = core::applyHomography(displayFromTable, tip.pad.head<2>());
+            const Eigen::Vector2d camera = core::applyHomography(tableToCamera, tip.pad.head<2>());
+            tip.display = {display.x(), display.y()};
+            tip.camera = {camera.x(), camera.y()};
+            truth.fingertips.push_back(tip);
+        }
+    }
+    // The table as precomputed, camera blur included; then, where hands and their shadows change it, the
+    // same computed again from the unblurred table with them, and blurred.
+    cv::scaleAdd(ambientBlurred_, ambientLux, projectedBlurred_[polarityIndex], blurred_);
+    castShadows(capsules, projectorBox);
+    const cv::Rect shadowBox = shadowOnTable(shadowBox_);
+    const cv::Rect changed = cameraBox | shadowBox;
+    if (changed.area() > 0) {
+        const cv::Rect image(0, 0, cameraSize.width, cameraSize.height);
+        const int reach = static_cast<int>(std::ceil(3.0 * parameters_.cameraDefocusPx));
+        const cv::Rect blurredPart = cv::Rect(changed.x - reach, changed.y - reach, changed.width + 2 * reach,
+                                              changed.height + 2 * reach) & image;
+        const cv::Rect inputPart = cv::Rect(changed.x - 2 * reach, changed.y - 2 * reach,
+                                            changed.width + 4 * reach, changed.height + 4 * reach) & image;
+        if (radiance_.empty())
+            radiance_ = cv::Mat::zeros(cameraSize, CV_32FC3);
+        cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart), radiance_(inputPart));
+        shadeTable(shadowBox, projected_[polarityIndex]);
+        castHands(capsules, cameraBox, polarityIndex, ambientLux, truth);
+        blurIfNeeded(radiance_(inputPart), partBlurred_, parameters_.cameraDefocusPx);
+        partBlurred_(blurredPart - inputPart.tl()).copyTo(blurred_(blurredPart));
+    }
+    sensor_.expose(blurred_, exposureMs, noiseSeed, image);
+}
+
+}  // namespace everytouch::sim

@@ -1,0 +1,94 @@
+#include "sim/simulator.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "sim/rig_geometry.h"
+
+namespace everytouch::sim {
+
+namespace {
+
+std::uint64_t mix(std::uint64_t value) {
+    value += 0x9E3779B97F4A7C15ull;
+    value = (value ^ (value >> 30)) * 0xBF58476D1CE4E5B9ull;
+    value = (value ^ (value >> 27)) * 0x94D049BB133111EBull;
+    return value ^ (value >> 31);
+}
+
+}  // namespace
+
+Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, const cv::Mat& contentImage)
+    : parameters_(parameters) {
+    if (auto problem = parameters_.validate())
+        throw std::invalid_argument(*problem);
+    calibration_ = rigCalibration(parameters_);
+    if (auto problem = calibration_.validate())
+        throw std::invalid_argument("the rig's geometry: " + *problem);
+    if (pattern.type() != CV_8UC1 || pattern.size() != calibration_.projectorSize)
+        throw std::invalid_argument("pattern: expected a CV_8UC1 image of the projector's size");
+    pattern_ = pattern.clone();
+    scenario_ = makeScenario(parameters_.scenario, {calibration_, parameters_.seed, parameters_.handScale});
+    renderer_ = std::make_unique<Renderer>(parameters_, calibration_, pattern_);
+    if (!contentImage.empty()) {
+        cv::Mat bgr, scaled;
+        if (contentImage.type() == CV_8UC1)
+            cv::cvtColor(contentImage, bgr, cv::COLOR_GRAY2BGR);
+        else if (contentImage.type() == CV_8UC3)
+            bgr = contentImage;
+        else
+            throw std::invalid_argument("content: expected an 8-bit gray or BGR image");
+        cv::resize(bgr, scaled, calibration_.displaySize, 0, 0, cv::INTER_AREA);
+        renderer_->setContent(scaled);
+        fixedImage_ = true;
+    } else if (parameters_.content != "auto") {
+        fixedKind_ = contentKindFromName(parameters_.content);
+        if (!fixedKind_)
+            throw std::invalid_argument("content: \"" + parameters_.content +
+                                        "\" is not a procedural kind (grid35, shapes, photo, ui, text, white, gray)");
+    }
+    exposureMs_ = parameters_.exposureMs ? *parameters_.exposureMs : renderer_->meterExposureMs(ambientLux(0.0));
+}
+
+std::optional<std::uint64_t> Simulator::frameCount() const {
+    if (!parameters_.durationS)
+        return std::nullopt;
+    return static_cast<std::uint64_t>(std::ceil(*parameters_.durationS * parameters_.frameRate - 1e-9));
+}
+
+std::int64_t Simulator::frameTimestampUs(std::uint64_t index) const {
+    return static_cast<std::int64_t>(std::llround(index * 1e6 / parameters_.frameRate));
+}
+
+double Simulator::ambientLux(double seconds) const {
+    if (parameters_.ambientChangeLux && seconds >= parameters_.ambientChangeAtS)
+        return *parameters_.ambientChangeLux;
+    return parameters_.ambientLux;
+}
+
+void Simulator::showContent(const SceneState& scene) {
+    if (fixedImage_)
+        return;
+    const std::pair<ContentKind, int> wanted =
+        fixedKind_ ? std::pair<ContentKind, int>(*fixedKind_, scene.contentVariant)
+                   : std::pair<ContentKind, int>(scene.content, scene.contentVariant);
+    if (shown_ == wanted)
+        return;
+    renderer_->setContent(renderContent(wanted.first, calibration_.displaySize, parameters_.seed, wanted.second));
+    shown_ = wanted;
+}
+
+void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& truth) {
+    const double seconds = frameSeconds(index);
+    const SceneState scene = scenario_->at(seconds);
+    showContent(scene);
+    frame.index = index;
+    frame.timestampUs = frameTimestampUs(index);
+    frame.polarity = framePolarity(index);
+    renderer_->render(scene.hands, frame.polarity, ambientLux(seconds), exposureMs_,
+                      mix(parameters_.seed ^ mix(index)), frame.image, truth);
+}
+
+}  // namespace everytouch::sim

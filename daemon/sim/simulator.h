@@ -1,0 +1,64 @@
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include <opencv2/core/mat.hpp>
+
+#include "core/calibration.h"
+#include "core/frame.h"
+#include "sim/renderer.h"
+#include "sim/scenario.h"
+#include "sim/sim_parameters.h"
+
+namespace everytouch::sim {
+
+// The simulated rig: a scenario played on the renderer. Frame k is exposed at k / frameRate seconds and shows
+// I = O + P for even k, I' = O - P for odd k; everything in it follows from the parameters, the pattern, the
+// content and k, so any frame can be rendered alone and again.
+class Simulator {
+public:
+    // pattern: CV_8UC1, projector size, 0/1. contentImage: when not empty, shown instead of any procedural
+    // content (8-bit gray or BGR, any size: it is scaled to the display). Throws std::invalid_argument when the
+    // parameters are invalid, name an unknown scenario, or name a content that is neither a procedural kind nor
+    // "auto" and no content image is given.
+    Simulator(const SimParameters& parameters, const cv::Mat& pattern, const cv::Mat& contentImage = cv::Mat());
+
+    const SimParameters& parameters() const { return parameters_; }
+    const core::Calibration& calibration() const { return calibration_; }
+    const cv::Mat& pattern() const { return pattern_; }
+    const Scenario& scenario() const { return *scenario_; }
+
+    // Frames in the session; nothing when it is endless.
+    std::optional<std::uint64_t> frameCount() const;
+    double frameSeconds(std::uint64_t index) const { return index / parameters_.frameRate; }
+    std::int64_t frameTimestampUs(std::uint64_t index) const;
+    static core::Polarity framePolarity(std::uint64_t index) {
+        return index % 2 == 0 ? core::Polarity::Positive : core::Polarity::Negative;
+    }
+    // Room light on the table at `seconds`.
+    double ambientLux(double seconds) const;
+    double exposureMs() const { return exposureMs_; }
+
+    // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`.
+    void render(std::uint64_t index, core::Frame& frame, FrameTruth& truth);
+
+    // The last render's noise-free radiance and renderer, for tests and pictures.
+    const Renderer& renderer() const { return *renderer_; }
+
+private:
+    void showContent(const SceneState& scene);
+
+    SimParameters parameters_;
+    core::Calibration calibration_;
+    cv::Mat pattern_;
+    std::unique_ptr<Scenario> scenario_;
+    std::unique_ptr<Renderer> renderer_;
+    std::optional<ContentKind> fixedKind_;  // content=KIND
+    bool fixedImage_ = false;               // content from an image
+    std::optional<std::pair<ContentKind, int>> shown_;
+    double exposureMs_ = 0.0;
+};
+
+}  // namespace everytouch::sim
