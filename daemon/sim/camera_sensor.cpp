@@ -31,9 +31,11 @@ CameraSensor::CameraSensor(const SimParameters& p, const core::Calibration& cali
     double balanceBgr[3];
     for (int c = 0; c < 3; ++c) {
         monoWeights_[c] = static_cast<float>(kMonoWeights[c] * responseBgr[c]);
-        balanceBgr[c] = colour_ == CameraColour::Mono || responseBgr[c] <= 0.0 ? 1.0 : responseBgr[1] / responseBgr[c];
-        centreGain_[c] = p.sensitivity / 1000.0 * (colour_ == CameraColour::Mono ? monoWeights_[c] : responseBgr[c]) *
-                         dnPerElectron_ * balanceBgr[c];
+        balanceBgr[c] =
+            colour_ == CameraColour::Mono || responseBgr[c] <= 0.0 ? 1.0 : responseBgr[1] / responseBgr[c];
+        centreGain_[c] = p.sensitivity / 1000.0 *
+                         (colour_ == CameraColour::Mono ? monoWeights_[c] : responseBgr[c]) * dnPerElectron_ *
+                         balanceBgr[c];
     }
     const bool mosaic = colour_ != CameraColour::Rgb;
     const int channels = mosaic ? 1 : 3;
@@ -43,12 +45,14 @@ CameraSensor::CameraSensor(const SimParameters& p, const core::Calibration& cali
         for (int x = 0; x < size.width; ++x) {
             const double tangent = std::hypot(x - cx, y - cy) / focal;
             const double cosine = 1.0 / std::sqrt(1.0 + tangent * tangent);
-            const double base = p.sensitivity / 1000.0 * std::pow(cosine, p.vignettingPower) * prnu.at<float>(y, x);
+            const double base =
+                p.sensitivity / 1000.0 * std::pow(cosine, p.vignettingPower) * prnu.at<float>(y, x);
             if (mosaic) {
                 const int channel = mosaicChannel(x, y);
                 const bool mono = colour_ == CameraColour::Mono;
                 chargeGain_.at<float>(y, x) = static_cast<float>(mono ? base : base * responseBgr[channel]);
-                dnGain_.at<float>(y, x) = static_cast<float>(dnPerElectron_ * (mono ? 1.0 : balanceBgr[channel]));
+                dnGain_.at<float>(y, x) =
+                    static_cast<float>(dnPerElectron_ * (mono ? 1.0 : balanceBgr[channel]));
             } else {
                 for (int c = 0; c < 3; ++c) {
                     chargeGain_.at<cv::Vec3f>(y, x)[c] = static_cast<float>(base * responseBgr[c]);
@@ -62,7 +66,8 @@ double CameraSensor::dnPerLux(int channel, double exposureMs) const {
     return centreGain_[channel] * exposureMs;
 }
 
-void CameraSensor::expose(const cv::Mat& radiance, double exposureMs, std::uint64_t noiseSeed, cv::Mat& image) {
+void CameraSensor::expose(const cv::Mat& radiance, double exposureMs, std::uint64_t noiseSeed,
+                          cv::Mat& image) {
     CV_Assert(radiance.type() == CV_32FC3 && radiance.size() == chargeGain_.size());
     const cv::Size size = radiance.size();
     // The light each pixel's colour filter lets through.
@@ -74,7 +79,8 @@ void CameraSensor::expose(const cv::Mat& radiance, double exposureMs, std::uint6
             float* out = filtered_.ptr<float>(y);
             if (colour_ == CameraColour::Mono) {
                 for (int x = 0; x < size.width; ++x)
-                    out[x] = monoWeights_[0] * in[3 * x] + monoWeights_[1] * in[3 * x + 1] + monoWeights_[2] * in[3 * x + 2];
+                    out[x] = monoWeights_[0] * in[3 * x] + monoWeights_[1] * in[3 * x + 1] +
+                             monoWeights_[2] * in[3 * x + 2];
             } else {
                 const int even = mosaicChannel(0, y), odd = mosaicChannel(1, y);
                 for (int x = 0; x + 1 < size.width; x += 2) {

@@ -29,12 +29,15 @@ public:
     double blackLevelDn() const { return blackLevel_; }
 
     // Channel behind the colour filter of pixel (x, y) of an RGGB Bayer sensor: 0 B, 1 G, 2 R.
-    static int mosaicChannel(int x, int y) { return y % 2 == 0 ? (x % 2 == 0 ? 2 : 1) : (x % 2 == 0 ? 1 : 0); }
+    static int mosaicChannel(int x, int y) {
+        return y % 2 == 0 ? (x % 2 == 0 ? 2 : 1) : (x % 2 == 0 ? 1 : 0);
+    }
 
 private:
     CameraColour colour_;
-    cv::Mat chargeGain_;  // electrons per lux-millisecond of each pixel (or channel): vignetting, PRNU, filter
-    cv::Mat dnGain_;      // DN per electron of each pixel (or channel): gain and white balance
+    cv::Mat
+        chargeGain_;  // electrons per lux-millisecond of each pixel (or channel): vignetting, PRNU, filter
+    cv::Mat dnGain_;  // DN per electron of each pixel (or channel): gain and white balance
     double dnPerElectron_;
     double fullWell_, readNoise_, blackLevel_;
     double centreGain_[3];  // white-balanced DN per lux-millisecond at the image centre

@@ -9,7 +9,7 @@ namespace everytouch::sim {
 // Points X of the shape satisfy  X = origin + axes * L  for L in the unit capsule: the segment from (0, 0, 0)
 // to (length, 0, 0) swept by the unit sphere.
 struct Capsule {
-    Eigen::Vector3d origin = Eigen::Vector3d::Zero();   // table mm
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();    // table mm
     Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();  // columns: axis direction x cap radius, then the two
                                                          // cross-section semi-axes, mm
     double length = 0.0;                                 // axis length in units of the cap radius

@@ -27,9 +27,10 @@ cv::Mat smoothNoise(cv::Size size, int cells, cv::RNG& rng) {
 }
 
 const char* randomWord(cv::RNG& rng) {
-    static const std::array<const char*, 24> words{
-        "table", "touch", "screen", "light", "code",  "finger", "camera",  "project", "window", "open",  "file",  "edit",
-        "view",  "help",  "the",    "and",   "of",    "image",  "display", "pattern", "hand",   "press", "point", "draw"};
+    static const std::array<const char*, 24> words{"table",   "touch",   "screen", "light", "code",  "finger",
+                                                   "camera",  "project", "window", "open",  "file",  "edit",
+                                                   "view",    "help",    "the",    "and",   "of",    "image",
+                                                   "display", "pattern", "hand",   "press", "point", "draw"};
     return words[rng.uniform(0, static_cast<int>(words.size()))];
 }
 
@@ -75,9 +76,9 @@ cv::Mat renderPhoto(cv::Size size, cv::RNG& rng) {
             const cv::Vec3f sky = skyTop * (1 - s) + skyLow * s;
             const float cloud = std::max(0.0f, clouds.at<float>(y, x) - 0.55f) * 2.0f;
             const cv::Vec3f value = sky * (1 - cloud) + cv::Vec3f(250, 250, 250) * cloud;
-            image.at<cv::Vec3b>(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(value[0]),
-                                                  cv::saturate_cast<uchar>(value[1]),
-                                                  cv::saturate_cast<uchar>(value[2]));
+            image.at<cv::Vec3b>(y, x) =
+                cv::Vec3b(cv::saturate_cast<uchar>(value[0]), cv::saturate_cast<uchar>(value[1]),
+                          cv::saturate_cast<uchar>(value[2]));
         }
     // Hills with a textured meadow.
     const cv::Mat texture = smoothNoise(size, 60, rng);
@@ -87,8 +88,9 @@ cv::Mat renderPhoto(cv::Size size, cv::RNG& rng) {
         const double phase = rng.uniform(0.0, 6.28), period = rng.uniform(0.6, 1.6);
         const int base = horizon + hill * size.height / 10;
         for (int x = 0; x <= size.width; x += 8)
-            outline.emplace_back(x, base - static_cast<int>(size.height / 12 *
-                                                            std::sin(phase + x * 6.28 / (period * size.width))));
+            outline.emplace_back(x,
+                                 base - static_cast<int>(size.height / 12 *
+                                                         std::sin(phase + x * 6.28 / (period * size.width))));
         outline.emplace_back(size.width, size.height);
         outline.emplace_back(0, size.height);
         cv::fillPoly(image, std::vector<std::vector<cv::Point>>{outline}, green, cv::LINE_AA);
@@ -106,8 +108,9 @@ cv::Mat renderPhoto(cv::Size size, cv::RNG& rng) {
         const int radius = rng.uniform(3, 9) * size.width / 640 + 1;
         for (int petal = 0; petal < 6; ++petal) {
             const double angle = petal * M_PI / 3;
-            cv::circle(image, centre + cv::Point(static_cast<int>(radius * std::cos(angle)),
-                                                 static_cast<int>(radius * std::sin(angle))),
+            cv::circle(image,
+                       centre + cv::Point(static_cast<int>(radius * std::cos(angle)),
+                                          static_cast<int>(radius * std::sin(angle))),
                        radius * 2 / 3 + 1, cv::Scalar(30, 210, 245), cv::FILLED, cv::LINE_AA);
         }
         cv::circle(image, centre, radius / 2 + 1, cv::Scalar(20, 110, 180), cv::FILLED, cv::LINE_AA);
@@ -119,8 +122,8 @@ cv::Mat renderPhoto(cv::Size size, cv::RNG& rng) {
         const int radius = size.height * rng.uniform(10, 20) / 100;
         const cv::Point centre(size.width * (i + 1) / (faces + 1), size.height - radius * 3 / 2);
         const cv::Scalar shirt = randomColour(rng);
-        cv::ellipse(image, centre + cv::Point(0, radius * 2), {radius * 3 / 2, radius * 6 / 5}, 0, 180, 360, shirt,
-                    cv::FILLED, cv::LINE_AA);
+        cv::ellipse(image, centre + cv::Point(0, radius * 2), {radius * 3 / 2, radius * 6 / 5}, 0, 180, 360,
+                    shirt, cv::FILLED, cv::LINE_AA);
         drawFace(image, centre, radius, kSkinColours[rng.uniform(0, 4)], rng);
     }
     cv::GaussianBlur(image, image, {0, 0}, 0.7);
@@ -141,7 +144,8 @@ cv::Mat renderUi(cv::Size size, cv::RNG& rng) {
     const int windows = rng.uniform(2, 5);
     for (int i = 0; i < windows; ++i) {
         const int w = size.width * rng.uniform(35, 70) / 100, h = size.height * rng.uniform(30, 60) / 100;
-        const cv::Rect frame(rng.uniform(size.width / 10, size.width - w), rng.uniform(0, size.height - h), w, h);
+        const cv::Rect frame(rng.uniform(size.width / 10, size.width - w), rng.uniform(0, size.height - h), w,
+                             h);
         cv::rectangle(image, frame, cv::Scalar(245, 245, 245), cv::FILLED);
         const int bar = static_cast<int>(24 * scale);
         const cv::Scalar accent = randomColour(rng, 40, 220);
@@ -149,13 +153,15 @@ cv::Mat renderUi(cv::Size size, cv::RNG& rng) {
         for (int b = 0; b < 3; ++b)
             cv::circle(image, {frame.x + frame.width - bar / 2 - b * bar, frame.y + bar / 2}, bar / 4,
                        cv::Scalar(60, 60, 220 - 60 * b), cv::FILLED, cv::LINE_AA);
-        const cv::Rect body(frame.x + bar / 2, frame.y + bar * 3 / 2, frame.width - bar, frame.height - bar * 3);
+        const cv::Rect body(frame.x + bar / 2, frame.y + bar * 3 / 2, frame.width - bar,
+                            frame.height - bar * 3);
         if (rng.uniform(0, 2) == 0) {
             const int radius = std::min(body.width, body.height) / 5;
-            drawFace(image, {body.x + radius + 4, body.y + radius + 4}, radius, kSkinColours[rng.uniform(0, 4)],
-                     rng);
-            drawTextLines(image, cv::Rect(body.x + radius * 2 + 12, body.y, body.width - radius * 2 - 12, body.height),
-                          0.45 * scale, cv::Scalar(30, 30, 30), rng);
+            drawFace(image, {body.x + radius + 4, body.y + radius + 4}, radius,
+                     kSkinColours[rng.uniform(0, 4)], rng);
+            drawTextLines(
+                image, cv::Rect(body.x + radius * 2 + 12, body.y, body.width - radius * 2 - 12, body.height),
+                0.45 * scale, cv::Scalar(30, 30, 30), rng);
         } else {
             drawTextLines(image, body, 0.45 * scale, cv::Scalar(30, 30, 30), rng);
         }
@@ -167,9 +173,10 @@ cv::Mat renderUi(cv::Size size, cv::RNG& rng) {
         cv::rectangle(image, frame, cv::Scalar(90, 90, 90), 1);
     }
     // Task bar.
-    cv::rectangle(image, cv::Rect(0, size.height - static_cast<int>(28 * scale), size.width,
-                                  static_cast<int>(28 * scale)),
-                  cv::Scalar(50, 45, 40), cv::FILLED);
+    cv::rectangle(
+        image,
+        cv::Rect(0, size.height - static_cast<int>(28 * scale), size.width, static_cast<int>(28 * scale)),
+        cv::Scalar(50, 45, 40), cv::FILLED);
     return image;
 }
 
@@ -179,8 +186,9 @@ cv::Mat renderText(cv::Size size, cv::RNG& rng) {
     const int margin = static_cast<int>(40 * scale);
     cv::putText(image, "Touchscreen everywhere", {margin, margin + static_cast<int>(10 * scale)},
                 cv::FONT_HERSHEY_DUPLEX, 0.9 * scale, cv::Scalar(20, 20, 20), 2, cv::LINE_AA);
-    drawTextLines(image, cv::Rect(margin, margin + static_cast<int>(25 * scale), size.width - 2 * margin,
-                                  size.height - 2 * margin - static_cast<int>(25 * scale)),
+    drawTextLines(image,
+                  cv::Rect(margin, margin + static_cast<int>(25 * scale), size.width - 2 * margin,
+                           size.height - 2 * margin - static_cast<int>(25 * scale)),
                   0.5 * scale, cv::Scalar(25, 25, 25), rng);
     return image;
 }
@@ -228,10 +236,15 @@ std::vector<std::vector<cv::Point2d>> dragShapes(cv::Size size) {
     const double top = (h - side) / 2;
     std::vector<std::vector<cv::Point2d>> shapes;
     const double squareLeft = w / 4 - side / 2;
-    shapes.push_back({{squareLeft, top}, {squareLeft + side, top}, {squareLeft + side, top + side},
-                      {squareLeft, top + side}, {squareLeft, top}});
+    shapes.push_back({{squareLeft, top},
+                      {squareLeft + side, top},
+                      {squareLeft + side, top + side},
+                      {squareLeft, top + side},
+                      {squareLeft, top}});
     const double triangleLeft = w / 2 - side / 2;
-    shapes.push_back({{triangleLeft, top}, {triangleLeft + side, top + side}, {triangleLeft, top + side},
+    shapes.push_back({{triangleLeft, top},
+                      {triangleLeft + side, top + side},
+                      {triangleLeft, top + side},
                       {triangleLeft, top}});
     std::vector<cv::Point2d> circle;
     const cv::Point2d centre(w * 3 / 4, h / 2);
@@ -244,14 +257,16 @@ std::vector<std::vector<cv::Point2d>> dragShapes(cv::Size size) {
 }
 
 cv::Mat renderContent(ContentKind kind, cv::Size size, std::uint64_t seed, int variant) {
-    cv::RNG rng(seed * 7919 + static_cast<std::uint64_t>(variant) * 104729 + static_cast<std::uint64_t>(kind));
+    cv::RNG rng(seed * 7919 + static_cast<std::uint64_t>(variant) * 104729 +
+                static_cast<std::uint64_t>(kind));
     const double scale = size.width / 640.0;
     switch (kind) {
         case ContentKind::Grid35: {
             cv::Mat image(size, CV_8UC3, cv::Scalar(245, 245, 245));
             const int radius = static_cast<int>(std::lround(std::min(size.width, size.height) * 0.045));
             for (const cv::Point2d& centre : grid35Centres(size)) {
-                const cv::Point c(static_cast<int>(std::lround(centre.x)), static_cast<int>(std::lround(centre.y)));
+                const cv::Point c(static_cast<int>(std::lround(centre.x)),
+                                  static_cast<int>(std::lround(centre.y)));
                 cv::circle(image, c, radius, cv::Scalar(60, 60, 60), std::max(1, static_cast<int>(2 * scale)),
                            cv::LINE_AA);
                 cv::drawMarker(image, c, cv::Scalar(40, 40, 200), cv::MARKER_CROSS, radius, 1, cv::LINE_AA);

@@ -14,11 +14,11 @@ namespace everytouch::sim {
 enum class ContentKind {
     Grid35,  // the paper's Fig. 15(a): 35 circles with crosses at their centres
     Shapes,  // the paper's Fig. 17(a): a square, a right triangle and a circle to drag along
-    Photo,   // photo-like: sky, hills, flowers, and skin-coloured faces (the hard case of colour segmentation)
-    Ui,      // a desktop: windows, title bars, buttons, icons, text, a skin-coloured avatar
-    Text,    // a page of text
-    White,   // uniform white
-    Gray,    // uniform mid-gray
+    Photo,  // photo-like: sky, hills, flowers, and skin-coloured faces (the hard case of colour segmentation)
+    Ui,     // a desktop: windows, title bars, buttons, icons, text, a skin-coloured avatar
+    Text,   // a page of text
+    White,  // uniform white
+    Gray,   // uniform mid-gray
 };
 
 std::optional<ContentKind> contentKindFromName(std::string_view name);

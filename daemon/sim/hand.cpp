@@ -11,22 +11,72 @@ constexpr double kDegree = M_PI / 180.0;
 
 // One finger of an average adult right hand in the wrist frame, mm (bone lengths include the soft tip).
 struct FingerAnatomy {
-    Eigen::Vector3d root;               // first joint
+    Eigen::Vector3d root;                          // first joint
     double restYawDeg, restPitchDeg, restRollDeg;  // direction of the straight finger
-    std::array<double, 3> length;       // bones, first to last
-    std::array<double, 3> width;        // side to side
-    std::array<double, 3> thickness;    // back to pad
-    double lastJointCoupling;           // third flexion = coupling x second flexion
+    std::array<double, 3> length;                  // bones, first to last
+    std::array<double, 3> width;                   // side to side
+    std::array<double, 3> thickness;               // back to pad
+    double lastJointCoupling;                      // third flexion = coupling x second flexion
     double abductionLimitDeg[2], firstFlexionLimitDeg[2], secondFlexionLimitDeg[2];
 };
 
 const std::array<FingerAnatomy, kFingerCount>& anatomy() {
     static const std::array<FingerAnatomy, kFingerCount> fingers{{
-        {{24, 20, -10}, 40, 25, 70, {44, 32, 27}, {21, 20, 18.5}, {17, 16, 14}, 0.8, {-20, 60}, {-20, 60}, {-10, 80}},
-        {{92, 25, 0}, 4, 0, 0, {42, 25, 21}, {18, 16.5, 15.5}, {14, 12.5, 11}, 0.7, {-25, 25}, {-30, 95}, {0, 110}},
-        {{96, 6, 1}, 0, 0, 0, {46, 28, 22}, {18.5, 17, 16}, {14.5, 13, 11.5}, 0.7, {-25, 25}, {-30, 95}, {0, 110}},
-        {{91, -12, 0}, -4, 0, 0, {43, 27, 21}, {17.5, 16, 15}, {14, 12.5, 11}, 0.7, {-25, 25}, {-30, 95}, {0, 110}},
-        {{80, -29, -2}, -9, 0, 0, {34, 20, 19}, {15.5, 14, 13}, {12.5, 11, 10}, 0.7, {-25, 25}, {-30, 95}, {0, 110}},
+        {{24, 20, -10},
+         40,
+         25,
+         70,
+         {44, 32, 27},
+         {21, 20, 18.5},
+         {17, 16, 14},
+         0.8,
+         {-20, 60},
+         {-20, 60},
+         {-10, 80}},
+        {{92, 25, 0},
+         4,
+         0,
+         0,
+         {42, 25, 21},
+         {18, 16.5, 15.5},
+         {14, 12.5, 11},
+         0.7,
+         {-25, 25},
+         {-30, 95},
+         {0, 110}},
+        {{96, 6, 1},
+         0,
+         0,
+         0,
+         {46, 28, 22},
+         {18.5, 17, 16},
+         {14.5, 13, 11.5},
+         0.7,
+         {-25, 25},
+         {-30, 95},
+         {0, 110}},
+        {{91, -12, 0},
+         -4,
+         0,
+         0,
+         {43, 27, 21},
+         {17.5, 16, 15},
+         {14, 12.5, 11},
+         0.7,
+         {-25, 25},
+         {-30, 95},
+         {0, 110}},
+        {{80, -29, -2},
+         -9,
+         0,
+         0,
+         {34, 20, 19},
+         {15.5, 14, 13},
+         {12.5, 11, 10},
+         0.7,
+         {-25, 25},
+         {-30, 95},
+         {0, 110}},
     }};
     return fingers;
 }
@@ -44,8 +94,8 @@ Eigen::Matrix3d rotX(double degrees) {
 // Wrist frame of a right hand -> table, including the mirror of a left hand and the hand's scale.
 Eigen::Affine3d wristFrameToTable(const HandPose& pose) {
     Eigen::Affine3d transform(pose.wristToTable);
-    transform.linear() = transform.linear() * Eigen::Vector3d(1.0, pose.left ? -1.0 : 1.0, 1.0).asDiagonal() *
-                         pose.scale;
+    transform.linear() =
+        transform.linear() * Eigen::Vector3d(1.0, pose.left ? -1.0 : 1.0, 1.0).asDiagonal() * pose.scale;
     return transform;
 }
 
@@ -90,7 +140,7 @@ void HandPose::place(const Eigen::Vector3d& wrist, double yawDeg, double pitchDe
 
 FingerJoints curledJoints(Finger finger) {
     if (finger == Finger::Thumb)
-        return {5.0, {20.0, 35.0, 30.0}};
+        return {-15.0, {35.0, 45.0, 30.0}};
     return {0.0, {75.0, 95.0, 65.0}};
 }
 
@@ -119,7 +169,8 @@ HandModel buildHand(const HandPose& pose) {
     const Eigen::Vector3d wristJoint(6.0, 0.0, -3.0);
     add(Capsule::bone(wristJoint, wristJoint + elbowward * 300.0, Eigen::Vector3d::UnitY(), 30.0, 22.0, 22.0),
         HandPart::Forearm);
-    add(Capsule::ellipsoid({50.0, 0.0, -4.0}, Eigen::Matrix3d::Identity(), {50.0, 40.0, 14.0}), HandPart::Palm);
+    add(Capsule::ellipsoid({50.0, 0.0, -4.0}, Eigen::Matrix3d::Identity(), {50.0, 40.0, 14.0}),
+        HandPart::Palm);
     add(Capsule::bone({88.0, 26.0, -3.0}, {78.0, -27.0, -4.0}, Eigen::Vector3d::UnitX(), 12.0, 11.5, 11.0),
         HandPart::Knuckles);
     add(Capsule::ellipsoid({38.0, 24.0, -10.0}, rotZ(35.0), {30.0, 15.0, 13.0}), HandPart::Thenar);
@@ -136,8 +187,8 @@ HandModel buildHand(const HandPose& pose) {
 }
 
 Eigen::Vector3d fingerPad(const HandPose& pose, Finger finger) {
-    const Capsule tip = toTable(fingerBones(pose.fingers[static_cast<int>(finger)], finger)[2],
-                                wristFrameToTable(pose));
+    const Capsule tip =
+        toTable(fingerBones(pose.fingers[static_cast<int>(finger)], finger)[2], wristFrameToTable(pose));
     return tip.supportPoint(-Eigen::Vector3d::UnitZ());
 }
 
@@ -170,11 +221,10 @@ double reachPad(HandPose& pose, Finger finger, const Eigen::Vector3d& target) {
             jacobian.col(i) = (residual(shifted) - r) / kStepDeg;
         }
         const Eigen::Matrix3d normal = jacobian.transpose() * jacobian;
-        Eigen::Vector3d candidate =
-            q - (normal + damping * Eigen::Matrix3d(normal.diagonal().asDiagonal()) +
-                 1e-9 * Eigen::Matrix3d::Identity())
-                    .ldlt()
-                    .solve(jacobian.transpose() * r);
+        Eigen::Vector3d candidate = q - (normal + damping * Eigen::Matrix3d(normal.diagonal().asDiagonal()) +
+                                         1e-9 * Eigen::Matrix3d::Identity())
+                                            .ldlt()
+                                            .solve(jacobian.transpose() * r);
         clampJoints(candidate);
         const Eigen::Vector3d candidateResidual = residual(candidate);
         if (candidateResidual.norm() < r.norm()) {

@@ -17,8 +17,8 @@ inline constexpr int kFingerCount = 5;
 // Joint angles of one finger. For the thumb the first joint is the carpometacarpal joint and the first bone
 // the metacarpal; for the others the first joint is the knuckle (MCP).
 struct FingerJoints {
-    double abductionDeg = 0.0;                      // sideways at the first joint, + towards the thumb
-    std::array<double, 3> flexionDeg{0, 0, 0};      // at the three joints, + curls towards the palm
+    double abductionDeg = 0.0;                  // sideways at the first joint, + towards the thumb
+    std::array<double, 3> flexionDeg{0, 0, 0};  // at the three joints, + curls towards the palm
 };
 
 // Where a hand is and how it is bent.
@@ -30,7 +30,7 @@ struct HandPose {
     // Fingers whose tips the person presents to the table (pointing, touching, hovering); curled fingers are
     // not reported as fingertips in the ground truth.
     std::array<bool, kFingerCount> presented{};
-    bool left = false;                 // a left hand: the mirror image of a right hand
+    bool left = false;                  // a left hand: the mirror image of a right hand
     double forearmElevationDeg = 15.0;  // the forearm rises behind the wrist, relative to the wrist's x axis
     double scale = 1.0;                 // size relative to an average adult hand
 

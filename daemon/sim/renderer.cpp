@@ -55,8 +55,8 @@ bool sampleBilinear(const cv::Mat& image, float x, float y, float* out) {
 
 // Image region containing a capsule: the union of the discs its two end spheres project to (a sphere swept
 // along the axis stays inside their convex hull). Conservative for off-axis spheres, whose images stretch.
-cv::Rect capsuleBox(const Capsule& capsule, const Eigen::Matrix3d& intrinsics, const Eigen::Isometry3d& tableToDevice,
-                    cv::Size image) {
+cv::Rect capsuleBox(const Capsule& capsule, const Eigen::Matrix3d& intrinsics,
+                    const Eigen::Isometry3d& tableToDevice, cv::Size image) {
     const double radius = capsule.axes.colwise().norm().maxCoeff();
     const double focal = std::max(intrinsics(0, 0), intrinsics(1, 1));
     double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
@@ -70,7 +70,8 @@ cv::Rect capsuleBox(const Capsule& capsule, const Eigen::Matrix3d& intrinsics, c
         minY = std::min(minY, q.y() / q.z() - reach), maxY = std::max(maxY, q.y() / q.z() + reach);
     }
     const cv::Rect box(static_cast<int>(std::floor(minX)), static_cast<int>(std::floor(minY)),
-                       static_cast<int>(std::ceil(maxX - minX)) + 2, static_cast<int>(std::ceil(maxY - minY)) + 2);
+                       static_cast<int>(std::ceil(maxX - minX)) + 2,
+                       static_cast<int>(std::ceil(maxY - minY)) + 2);
     return box & cv::Rect(0, 0, image.width, image.height);
 }
 
@@ -105,24 +106,31 @@ cv::Mat toCv(const Eigen::Matrix3d& m) {
 struct Renderer::PreparedCapsule {
     CapsuleHit camera;
     CapsuleHit projector;
-    Eigen::Matrix3f cameraPixelToLocal;     // (u, v, 1) -> local direction
+    Eigen::Matrix3f cameraPixelToLocal;  // (u, v, 1) -> local direction
     Eigen::Matrix3f projectorPixelToLocal;
     cv::Rect cameraBox, projectorBox;
     HandPart part;
     float length;
 };
 
-Renderer::Renderer(const SimParameters& parameters, const core::Calibration& calibration, const cv::Mat& pattern)
-    : parameters_(parameters), calibration_(calibration), pattern_(pattern.clone()), sensor_(parameters, calibration) {
+Renderer::Renderer(const SimParameters& parameters, const core::Calibration& calibration,
+                   const cv::Mat& pattern)
+    : parameters_(parameters),
+      calibration_(calibration),
+      pattern_(pattern.clone()),
+      sensor_(parameters, calibration) {
     CV_Assert(pattern.type() == CV_8UC1 && pattern.size() == calibration.projectorSize);
     const SimParameters& p = parameters_;
     const cv::Size cameraSize = calibration.cameraSize, panelSize = calibration.projectorSize;
     cameraCentre_ = calibration.tableToCamera.inverse().translation();
     projectorCentre_ = calibration.tableToProjector.inverse().translation();
     cameraPixelToRay_ = calibration.tableToCamera.rotation().transpose() * calibration.cameraMatrix.inverse();
-    projectorPixelToRay_ = calibration.tableToProjector.rotation().transpose() * calibration.projectorMatrix.inverse();
-    projectorProjection_ = (calibration.projectorMatrix * calibration.tableToProjector.rotation()).cast<float>();
-    projectorTranslation_ = (calibration.projectorMatrix * calibration.tableToProjector.translation()).cast<float>();
+    projectorPixelToRay_ =
+        calibration.tableToProjector.rotation().transpose() * calibration.projectorMatrix.inverse();
+    projectorProjection_ =
+        (calibration.projectorMatrix * calibration.tableToProjector.rotation()).cast<float>();
+    projectorTranslation_ =
+        (calibration.projectorMatrix * calibration.tableToProjector.translation()).cast<float>();
     cameraToProjector_ = calibration.cameraToProjectorHomography(0.0);
     projectorToCamera_ = cameraToProjector_.inverse();
 
@@ -137,24 +145,27 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
     const double halfW = (panelSize.width - 1) / 2.0, halfH = (panelSize.height - 1) / 2.0;
     for (int y = 0; y < panelSize.height; ++y)
         for (int x = 0; x < panelSize.width; ++x) {
-            const double r2 = ((x - halfW) * (x - halfW) + (y - halfH) * (y - halfH)) /
-                              (halfW * halfW + halfH * halfH);
-            panelFalloff_.at<cv::Vec3f>(y, x) = cv::Vec3f::all(static_cast<float>(1.0 - (1.0 - p.projectorCornerFalloff) * r2));
+            const double r2 =
+                ((x - halfW) * (x - halfW) + (y - halfH) * (y - halfH)) / (halfW * halfW + halfH * halfH);
+            panelFalloff_.at<cv::Vec3f>(y, x) =
+                cv::Vec3f::all(static_cast<float>(1.0 - (1.0 - p.projectorCornerFalloff) * r2));
         }
 
-    // The table seen by each camera pixel: albedo integrated over the pixel, and the projector's light falloff.
+    // The table seen by each camera pixel: albedo integrated over the pixel, and the projector's light
+    // falloff.
     const Eigen::Matrix3d cameraToTable = calibration.tableToCameraHomography().inverse();
     double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
-    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(cameraSize.width, 0),
-                                          Eigen::Vector2d(0, cameraSize.height),
-                                          Eigen::Vector2d(cameraSize.width, cameraSize.height)}) {
+    for (const Eigen::Vector2d& corner :
+         {Eigen::Vector2d(0, 0), Eigen::Vector2d(cameraSize.width, 0), Eigen::Vector2d(0, cameraSize.height),
+          Eigen::Vector2d(cameraSize.width, cameraSize.height)}) {
         const Eigen::Vector2d table = core::applyHomography(cameraToTable, corner);
         minX = std::min(minX, table.x()), maxX = std::max(maxX, table.x());
         minY = std::min(minY, table.y()), maxY = std::max(maxY, table.y());
     }
     const double margin = 10.0;
     const SurfaceTexture surface = makeSurface(
-        p.surface, cv::Rect2d(minX - margin, minY - margin, maxX - minX + 2 * margin, maxY - minY + 2 * margin),
+        p.surface,
+        cv::Rect2d(minX - margin, minY - margin, maxX - minX + 2 * margin, maxY - minY + 2 * margin),
         kTexelMm, p.seed);
     const int n = p.pixelSamples;
     albedo_ = cv::Mat::zeros(cameraSize, CV_32FC3);
@@ -163,8 +174,8 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
         for (int j = 0; j < n; ++j) {
             Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
             offset(0, 2) = (i + 0.5) / n - 0.5, offset(1, 2) = (j + 0.5) / n - 0.5;
-            cv::warpPerspective(surface.albedo, sample, toCv(surface.tableToTexel * cameraToTable * offset), cameraSize,
-                                cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+            cv::warpPerspective(surface.albedo, sample, toCv(surface.tableToTexel * cameraToTable * offset),
+                                cameraSize, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
             cv::accumulate(sample, albedo_);
         }
     albedo_ /= 255.0 * n * n;
@@ -174,7 +185,8 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
             const Eigen::Vector2d table = core::applyHomography(cameraToTable, {x, y});
             const double r2 = (projectorCentre_ - Eigen::Vector3d(table.x(), table.y(), 0)).squaredNorm();
             const double cosine = projectorCentre_.z() / std::sqrt(r2);
-            tableIncidence_.at<float>(y, x) = static_cast<float>(referenceDistance2_ / r2 * cosine / referenceCosine_);
+            tableIncidence_.at<float>(y, x) =
+                static_cast<float>(referenceDistance2_ / r2 * cosine / referenceCosine_);
         }
     const Eigen::Vector3f ambient = toBgr(p.ambientColour.cast<float>());
     ambientBgr_ = ambient;
@@ -210,24 +222,23 @@ void Renderer::setContent(const cv::Mat& displayContent) {
     const SimParameters& p = parameters_;
     const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
     cv::Mat panelContent, images[2];
-    cv::warpPerspective(displayContent, panelContent, toCv(calibration_.displayToProjector), panelSize, cv::INTER_LINEAR,
-                        cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    cv::warpPerspective(displayContent, panelContent, toCv(calibration_.displayToProjector), panelSize,
+                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
     core::embedCode(panelContent, pattern_, p.delta, images[0], images[1]);
 
     // Projector transfer: digital level -> light, as a fraction of white.
     cv::Mat transfer(1, 256, CV_32F);
     for (int level = 0; level < 256; ++level)
         transfer.at<float>(level) = static_cast<float>(
-            p.projectorWhiteLux * (p.projectorBlackLevel +
-                                   (1.0 - p.projectorBlackLevel) * std::pow(level / 255.0, p.projectorGamma)));
+            p.projectorWhiteLux * (p.projectorBlackLevel + (1.0 - p.projectorBlackLevel) *
+                                                               std::pow(level / 255.0, p.projectorGamma)));
 
-    // Blur scales in panel pixels: the camera pixel's footprint (a box, as a Gaussian of equal variance) and the
-    // light's spread inside skin.
+    // Blur scales in panel pixels: the camera pixel's footprint (a box, as a Gaussian of equal variance) and
+    // the light's spread inside skin.
     const Eigen::Vector2d cameraCentre((cameraSize.width - 1) / 2.0, (cameraSize.height - 1) / 2.0);
     const double footprint = jacobianScale(cameraToProjector_, cameraCentre);
-    const double mmPerPanelPixel =
-        jacobianScale(calibration_.tableToProjectorHomography().inverse(),
-                      core::applyHomography(cameraToProjector_, cameraCentre));
+    const double mmPerPanelPixel = jacobianScale(calibration_.tableToProjectorHomography().inverse(),
+                                                 core::applyHomography(cameraToProjector_, cameraCentre));
     const double direct2 = p.projectorDefocusPx * p.projectorDefocusPx + footprint * footprint / 12.0;
 
     const int n = p.pixelSamples;
@@ -246,7 +257,8 @@ void Renderer::setContent(const cv::Mat& displayContent) {
                 Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
                 offset(0, 2) = (i + 0.5) / n - 0.5, offset(1, 2) = (j + 0.5) / n - 0.5;
                 cv::warpPerspective(blurred, sample, toCv(cameraToProjector_ * offset), cameraSize,
-                                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+                                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                                    cv::Scalar::all(0));
                 accumulated += sample;
             }
         accumulated *= 1.0 / (n * n);
@@ -334,12 +346,14 @@ cv::Rect Renderer::shadowOnTable(const cv::Rect& projectorBox) const {
 void Renderer::shadeTable(const cv::Rect& box, const cv::Mat& projected) {
     if (box.area() == 0 || shadowBox_.area() == 0)
         return;
-    // The shadow mask seen through the table plane: camera pixel (x, y) of `box` -> panel pixel of shadowBox_.
+    // The shadow mask seen through the table plane: camera pixel (x, y) of `box` -> panel pixel of
+    // shadowBox_.
     Eigen::Matrix3d toPanel = Eigen::Matrix3d::Identity(), fromCamera = Eigen::Matrix3d::Identity();
     toPanel(0, 2) = -shadowBox_.x, toPanel(1, 2) = -shadowBox_.y;
     fromCamera(0, 2) = box.x, fromCamera(1, 2) = box.y;
-    cv::warpPerspective(shadowMask_(shadowBox_), blockedOnTable_, toCv(toPanel * cameraToProjector_ * fromCamera),
-                        box.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::warpPerspective(shadowMask_(shadowBox_), blockedOnTable_,
+                        toCv(toPanel * cameraToProjector_ * fromCamera), box.size(),
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
     for (int y = 0; y < box.height; ++y) {
         const float* blocked = blockedOnTable_.ptr<float>(y);
         float* out = radiance_.ptr<float>(box.y + y) + 3 * box.x;
@@ -350,8 +364,8 @@ void Renderer::shadeTable(const cv::Rect& box, const cv::Mat& projected) {
     }
 }
 
-void Renderer::shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t, int polarityIndex,
-                        double ambientLux, float* bgr, float& height) const {
+void Renderer::shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t,
+                        int polarityIndex, double ambientLux, float* bgr, float& height) const {
     const Eigen::Vector3f point = cameraCentre_.cast<float>() + t * direction;
     const Eigen::Vector3f normal = capsule.camera.normal(direction, t);
     height = point.z();
@@ -423,8 +437,8 @@ void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv:
         for (int x = box.x; x < box.x + w; ++x) {
             const bool hit = index[x] >= 0;
             const int left = std::max(x - 1, box.x), right = std::min(x + 1, box.x + w - 1);
-            const bool edge = (index[left] >= 0) != hit || (index[right] >= 0) != hit || (above[x] >= 0) != hit ||
-                              (below[x] >= 0) != hit;
+            const bool edge = (index[left] >= 0) != hit || (index[right] >= 0) != hit ||
+                              (above[x] >= 0) != hit || (below[x] >= 0) != hit;
             if (!hit && !edge)
                 continue;
             int shadeIndex = index[x];
@@ -435,13 +449,15 @@ void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv:
                 // Integrate the silhouette over the pixel with four samples.
                 int hits = 0;
                 for (int s = 0; s < 4; ++s) {
-                    const Eigen::Vector3f pixel(x + ((s & 1) ? 0.25f : -0.25f), y + ((s & 2) ? 0.25f : -0.25f), 1.0f);
+                    const Eigen::Vector3f pixel(x + ((s & 1) ? 0.25f : -0.25f),
+                                                y + ((s & 2) ? 0.25f : -0.25f), 1.0f);
                     float best = kNoHit;
                     int bestIndex = -1;
                     for (size_t k = 0; k < capsules.size(); ++k) {
                         if (!capsules[k].cameraBox.contains({x, y}))
                             continue;
-                        const float t = capsules[k].camera.intersectLocal(capsules[k].cameraPixelToLocal * pixel);
+                        const float t =
+                            capsules[k].camera.intersectLocal(capsules[k].cameraPixelToLocal * pixel);
                         if (t > 0.0f && t < best)
                             best = t, bestIndex = static_cast<int>(k);
                     }
@@ -468,8 +484,8 @@ void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv:
     }
 }
 
-void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarity, double ambientLux, double exposureMs,
-                      std::uint64_t noiseSeed, cv::Mat& image, FrameTruth& truth) {
+void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarity, double ambientLux,
+                      double exposureMs, std::uint64_t noiseSeed, cv::Mat& image, FrameTruth& truth) {
     CV_Assert(!projected_[0].empty());
     const int polarityIndex = polarity == core::Polarity::Positive ? 0 : 1;
     const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
@@ -490,16 +506,16 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
     for (size_t h = 0; h < hands.size(); ++h) {
         const HandModel model = buildHand(hands[h]);
         for (const HandCapsule& part : model.capsules) {
-            PreparedCapsule capsule{CapsuleHit(part.shape, cameraCentre_),
-                                    CapsuleHit(part.shape, projectorCentre_),
-                                    Eigen::Matrix3f(),
-                                    Eigen::Matrix3f(),
-                                    capsuleBox(part.shape, calibration_.cameraMatrix, calibration_.tableToCamera,
-                                               cameraSize),
-                                    capsuleBox(part.shape, calibration_.projectorMatrix,
-                                               calibration_.tableToProjector, panelSize),
-                                    part.part,
-                                    static_cast<float>(part.shape.length)};
+            PreparedCapsule capsule{
+                CapsuleHit(part.shape, cameraCentre_),
+                CapsuleHit(part.shape, projectorCentre_),
+                Eigen::Matrix3f(),
+                Eigen::Matrix3f(),
+                capsuleBox(part.shape, calibration_.cameraMatrix, calibration_.tableToCamera, cameraSize),
+                capsuleBox(part.shape, calibration_.projectorMatrix, calibration_.tableToProjector,
+                           panelSize),
+                part.part,
+                static_cast<float>(part.shape.length)};
             capsule.cameraPixelToLocal = capsule.camera.toLocal() * cameraPixelToRay;
             capsule.projectorPixelToLocal = capsule.projector.toLocal() * projectorPixelToRay;
             cameraBox |= capsule.cameraBox;
@@ -532,12 +548,15 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
         const cv::Rect image(0, 0, cameraSize.width, cameraSize.height);
         const int reach = static_cast<int>(std::ceil(3.0 * parameters_.cameraDefocusPx));
         const cv::Rect blurredPart = cv::Rect(changed.x - reach, changed.y - reach, changed.width + 2 * reach,
-                                              changed.height + 2 * reach) & image;
+                                              changed.height + 2 * reach) &
+                                     image;
         const cv::Rect inputPart = cv::Rect(changed.x - 2 * reach, changed.y - 2 * reach,
-                                            changed.width + 4 * reach, changed.height + 4 * reach) & image;
+                                            changed.width + 4 * reach, changed.height + 4 * reach) &
+                                   image;
         if (radiance_.empty())
             radiance_ = cv::Mat::zeros(cameraSize, CV_32FC3);
-        cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart), radiance_(inputPart));
+        cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart),
+                     radiance_(inputPart));
         shadeTable(shadowBox, projected_[polarityIndex]);
         castHands(capsules, cameraBox, polarityIndex, ambientLux, truth);
         blurIfNeeded(radiance_(inputPart), partBlurred_, parameters_.cameraDefocusPx);

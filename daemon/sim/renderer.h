@@ -17,15 +17,15 @@ namespace everytouch::sim {
 
 // Ground truth of one fingertip in one frame.
 struct FingertipTruth {
-    int hand = 0;                     // index of the hand in the scene
+    int hand = 0;  // index of the hand in the scene
     Finger finger = Finger::Index;
-    std::uint32_t id = 0;             // hand * 5 + finger: stable for the scenario
-    Eigen::Vector3d pad;              // lowest point of the fingertip, table mm
-    double heightMm = 0.0;            // pad above the table; exactly 0 when touching
+    std::uint32_t id = 0;   // hand * 5 + finger: stable for the scenario
+    Eigen::Vector3d pad;    // lowest point of the fingertip, table mm
+    double heightMm = 0.0;  // pad above the table; exactly 0 when touching
     bool touching = false;
-    bool presented = false;           // pointing, touching or hovering, not curled into the hand
-    cv::Point2d display;              // contact point (the pad's foot on the table), display pixels
-    cv::Point2d camera;               // the same table point in the camera image, pixels
+    bool presented = false;  // pointing, touching or hovering, not curled into the hand
+    cv::Point2d display;     // contact point (the pad's foot on the table), display pixels
+    cv::Point2d camera;      // the same table point in the camera image, pixels
 };
 
 // What the renderer knows about one frame besides the image.
@@ -75,8 +75,8 @@ private:
     void shadeTable(const cv::Rect& cameraBox, const cv::Mat& projected);
     void castHands(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box, int polarityIndex,
                    double ambientLux, FrameTruth& truth);
-    void shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t, int polarityIndex,
-                  double ambientLux, float* bgr, float& height) const;
+    void shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t,
+                  int polarityIndex, double ambientLux, float* bgr, float& height) const;
 
     SimParameters parameters_;
     core::Calibration calibration_;
@@ -85,18 +85,18 @@ private:
     // Devices, in float for the per-pixel work.
     Eigen::Vector3d cameraCentre_, projectorCentre_;
     Eigen::Matrix3d cameraPixelToRay_, projectorPixelToRay_;  // (u, v, 1) -> table-frame direction, z-depth 1
-    Eigen::Matrix3f projectorProjection_;                      // K_p R_p
-    Eigen::Vector3f projectorTranslation_;                     // K_p t_p
-    Eigen::Matrix3d cameraToProjector_;                        // table-plane homography
+    Eigen::Matrix3f projectorProjection_;                     // K_p R_p
+    Eigen::Vector3f projectorTranslation_;                    // K_p t_p
+    Eigen::Matrix3d cameraToProjector_;                       // table-plane homography
     Eigen::Matrix3d projectorToCamera_;
     double referenceDistance2_ = 1.0;  // squared projector distance of the display centre
     double referenceCosine_ = 1.0;     // incidence cosine there
     // Static images.
-    cv::Mat panelFalloff_;      // CV_32FC3, projector size: relative light of each panel pixel (vignetting)
-    cv::Mat albedo_;            // CV_32FC3, camera size: table reflectance integrated over each pixel
-    cv::Mat tableIncidence_;    // CV_32FC1, camera size: projector light falloff on the table (1 at the centre)
-    cv::Mat ambientTerm_;       // CV_32FC3: albedo x ambient colour
-    cv::Mat ambientBlurred_;    // the same through the camera's blur
+    cv::Mat panelFalloff_;    // CV_32FC3, projector size: relative light of each panel pixel (vignetting)
+    cv::Mat albedo_;          // CV_32FC3, camera size: table reflectance integrated over each pixel
+    cv::Mat tableIncidence_;  // CV_32FC1, camera size: projector light falloff on the table (1 at the centre)
+    cv::Mat ambientTerm_;     // CV_32FC3: albedo x ambient colour
+    cv::Mat ambientBlurred_;  // the same through the camera's blur
     Eigen::Vector3f skinBgr_, nailBgr_;
     Eigen::Vector3f ambientBgr_;
     // Per content: for I and I', the table radiance from the projector (camera size) and the light as skin
@@ -105,16 +105,16 @@ private:
     cv::Mat projectedBlurred_[2];
     cv::Mat skinLight_[2];
     // Per-frame buffers.
-    cv::Mat shadowDepth_;   // CV_32FC1, projector size: depth of the nearest hand along each projector ray
-    cv::Mat shadowMask_;    // CV_32FC1, projector size: fraction of each panel pixel's light the hands block
+    cv::Mat shadowDepth_;  // CV_32FC1, projector size: depth of the nearest hand along each projector ray
+    cv::Mat shadowMask_;   // CV_32FC1, projector size: fraction of each panel pixel's light the hands block
     cv::Rect shadowBox_;
-    cv::Mat depth_;         // CV_32FC1, camera size: nearest hand hit per pixel
-    cv::Mat hitIndex_;      // CV_16SC1: capsule of that hit, -1 for none
-    cv::Mat radiance_;      // CV_32FC3, camera size: unblurred radiance, valid where hands changed it
-    cv::Mat blurred_;       // CV_32FC3, camera size: radiance through the camera's blur
+    cv::Mat depth_;     // CV_32FC1, camera size: nearest hand hit per pixel
+    cv::Mat hitIndex_;  // CV_16SC1: capsule of that hit, -1 for none
+    cv::Mat radiance_;  // CV_32FC3, camera size: unblurred radiance, valid where hands changed it
+    cv::Mat blurred_;   // CV_32FC3, camera size: radiance through the camera's blur
     cv::Mat partBlurred_;
     cv::Mat blockedOnTable_;  // CV_32FC1: shadow mask in camera pixels of the shadow's region
-    cv::Mat work_[4];       // content precomputation
+    cv::Mat work_[4];         // content precomputation
 };
 
 }  // namespace everytouch::sim

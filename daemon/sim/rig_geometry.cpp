@@ -36,7 +36,8 @@ core::Calibration rigCalibration(const SimParameters& p) {
     calibration.cameraSize = p.cameraSize;
     const double cameraFocalPx = p.cameraFocalMm * 1000.0 / p.cameraPixelUm;
     const Eigen::Vector2d cameraCentre((p.cameraSize.width - 1) / 2.0, (p.cameraSize.height - 1) / 2.0);
-    calibration.cameraMatrix << cameraFocalPx, 0, cameraCentre.x(), 0, cameraFocalPx, cameraCentre.y(), 0, 0, 1;
+    calibration.cameraMatrix << cameraFocalPx, 0, cameraCentre.x(), 0, cameraFocalPx, cameraCentre.y(), 0, 0,
+        1;
     calibration.tableToCamera =
         aimDevice(calibration.cameraMatrix, cameraCentre, p.cameraPosition, p.cameraTarget);
 

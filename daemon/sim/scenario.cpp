@@ -13,10 +13,10 @@ namespace everytouch::sim {
 
 namespace {
 
-constexpr double kHoverMm = 35.0;        // height of a finger travelling between taps
-constexpr double kEnterSeconds = 1.0;    // a hand coming into view or leaving it
+constexpr double kHoverMm = 35.0;      // height of a finger travelling between taps
+constexpr double kEnterSeconds = 1.0;  // a hand coming into view or leaving it
 constexpr double kPointingPitchDeg = 15.0;
-constexpr double kUserYawDeg = -90.0;    // a hand of the user at +y points towards -y
+constexpr double kUserYawDeg = -90.0;  // a hand of the user at +y points towards -y
 
 double smoother(double x) {
     x = std::clamp(x, 0.0, 1.0);
@@ -25,7 +25,8 @@ double smoother(double x) {
 
 // Random numbers of one cycle of one scenario.
 cv::RNG cycleRng(std::uint64_t seed, int scenarioId, long cycle) {
-    std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(scenarioId) * 0xBF58476D1CE4E5B9ull +
+    std::uint64_t state = seed * 0x9E3779B97F4A7C15ull +
+                          static_cast<std::uint64_t>(scenarioId) * 0xBF58476D1CE4E5B9ull +
                           static_cast<std::uint64_t>(cycle) * 0x94D049BB133111EBull;
     state ^= state >> 31;
     return cv::RNG(state | 1);
@@ -48,7 +49,8 @@ public:
     }
     // A point beyond the display's edge on the user's side, out of the camera's view.
     Eigen::Vector3d offstage(double x) const {
-        const double userEdge = onTable({displaySize_.width / 2.0, static_cast<double>(displaySize_.height)}).y();
+        const double userEdge =
+            onTable({displaySize_.width / 2.0, static_cast<double>(displaySize_.height)}).y();
         return {x, userEdge + 330.0, 160.0};
     }
     cv::Size displaySize() const { return displaySize_; }
@@ -157,8 +159,8 @@ private:
     Track buildTrack(long cycle) const override {
         cv::RNG rng = cycleRng(seed_, id_, cycle);
         const std::vector<cv::Point2d> centres = grid35Centres(stage_.displaySize());
-        const int first = taps_ < static_cast<int>(centres.size()) ? rng.uniform(0, static_cast<int>(centres.size()))
-                                                                    : 0;
+        const int first =
+            taps_ < static_cast<int>(centres.size()) ? rng.uniform(0, static_cast<int>(centres.size())) : 0;
         Track track;
         const Eigen::Vector3d start = stage_.onTable(centres[first], kHoverMm);
         track.add(0.0, stage_.offstage(start.x()), kUserYawDeg);
@@ -166,7 +168,8 @@ private:
             const cv::Point2d& centre = centres[(first + i) % centres.size()];
             const double base = kEnterSeconds + i * kSlotSeconds;
             const double yaw = kUserYawDeg + rng.gaussian(6.0);
-            const Eigen::Vector3d aim = stage_.onTable(centre) + Eigen::Vector3d(rng.gaussian(1.2), rng.gaussian(1.2), 0);
+            const Eigen::Vector3d aim =
+                stage_.onTable(centre) + Eigen::Vector3d(rng.gaussian(1.2), rng.gaussian(1.2), 0);
             const double hoverLow = rng.uniform(5.0, 12.0);
             const double pause = rng.uniform(0.0, 0.2);
             const double dwell = rng.uniform(0.18, 0.32);
@@ -189,7 +192,8 @@ private:
 // The paper's Fig. 17 experiment: drag the index along a square, a right triangle and a circle.
 class DragScenario final : public PointingScenario {
 public:
-    explicit DragScenario(const ScenarioContext& context) : PointingScenario(context, 2, ContentKind::Shapes) {}
+    explicit DragScenario(const ScenarioContext& context)
+        : PointingScenario(context, 2, ContentKind::Shapes) {}
 
 private:
     static constexpr double kSpeedMmPerS = 60.0;
@@ -249,10 +253,13 @@ private:
         double t = 0.0;
         for (int pass = 0; pass < passes_; ++pass) {
             const double height = heights[pass % heights.size()];
-            const double y0 = rng.uniform(0.15, 0.85) * display.height, y1 = rng.uniform(0.15, 0.85) * display.height;
+            const double y0 = rng.uniform(0.15, 0.85) * display.height,
+                         y1 = rng.uniform(0.15, 0.85) * display.height;
             const bool leftToRight = rng.uniform(0, 2) == 0;
-            const double x0 = (leftToRight ? 0.12 : 0.88) * display.width, x1 = (leftToRight ? 0.88 : 0.12) * display.width;
-            const Eigen::Vector3d from = stage_.onTable({x0, y0}, height), to = stage_.onTable({x1, y1}, height);
+            const double x0 = (leftToRight ? 0.12 : 0.88) * display.width,
+                         x1 = (leftToRight ? 0.88 : 0.12) * display.width;
+            const Eigen::Vector3d from = stage_.onTable({x0, y0}, height),
+                                  to = stage_.onTable({x1, y1}, height);
             const double yaw = kUserYawDeg + rng.gaussian(8.0);
             if (pass == 0) {
                 track.add(t, stage_.offstage(from.x()), kUserYawDeg);
@@ -324,20 +331,22 @@ public:
         const double yaw = kUserYawDeg + rng.gaussian(8.0);
         switch (gesture) {
             case 0:  // pinch: thumb and index close in
-                state.hands.push_back(gestureHand(centre, yaw, false, {Finger::Thumb, Finger::Index}, 1.15 - 0.75 * act, 0.0,
-                                                  height, offset));
+                state.hands.push_back(gestureHand(centre, yaw, false, {Finger::Thumb, Finger::Index},
+                                                  1.15 - 0.75 * act, 0.0, height, offset));
                 break;
             case 1:  // spread: five fingers move apart
-                state.hands.push_back(gestureHand(centre, yaw, false,
-                                                  {Finger::Thumb, Finger::Index, Finger::Middle, Finger::Ring, Finger::Little},
-                                                  0.8 + 0.4 * act, 0.0, height, offset));
+                state.hands.push_back(
+                    gestureHand(centre, yaw, false,
+                                {Finger::Thumb, Finger::Index, Finger::Middle, Finger::Ring, Finger::Little},
+                                0.8 + 0.4 * act, 0.0, height, offset));
                 break;
             case 2:  // rotate: thumb and index turn about their midpoint
-                state.hands.push_back(gestureHand(centre, yaw, false, {Finger::Thumb, Finger::Index}, 1.0, 55.0 * act,
-                                                  height, offset));
+                state.hands.push_back(gestureHand(centre, yaw, false, {Finger::Thumb, Finger::Index}, 1.0,
+                                                  55.0 * act, height, offset));
                 break;
             default: {  // ten fingers: two hands spreading and moving apart
-                const std::vector<Finger> all{Finger::Thumb, Finger::Index, Finger::Middle, Finger::Ring, Finger::Little};
+                const std::vector<Finger> all{Finger::Thumb, Finger::Index, Finger::Middle, Finger::Ring,
+                                              Finger::Little};
                 const Eigen::Vector3d apart(55.0 + 25.0 * act, 0.0, 0.0);
                 state.hands.push_back(gestureHand(stage_.centre() - apart, kUserYawDeg + 12.0, false, all,
                                                   0.85 + 0.3 * act, 0.0, height, offset));
@@ -355,8 +364,9 @@ private:
 
     // A hand whose `fingers` rest at their natural spread around `centre`, scaled about their centroid by
     // `spread` and turned about it by `turnDeg`, at `heightMm` above the table; the rest curl up.
-    HandPose gestureHand(const Eigen::Vector3d& centre, double yawDeg, bool left, const std::vector<Finger>& fingers,
-                         double spread, double turnDeg, double heightMm, const Eigen::Vector3d& offset) const {
+    HandPose gestureHand(const Eigen::Vector3d& centre, double yawDeg, bool left,
+                         const std::vector<Finger>& fingers, double spread, double turnDeg, double heightMm,
+                         const Eigen::Vector3d& offset) const {
         HandPose pose = relaxedHand(Eigen::Vector3d::Zero(), yawDeg, 8.0, left, stage_.handScale());
         pose.place(wristFor(pose, centre), yawDeg, 8.0);
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -397,7 +407,8 @@ private:
 // A palm resting on the table while the index finger taps; the other fingers rest just above the table.
 class PalmScenario final : public Scenario {
 public:
-    PalmScenario(const ScenarioContext& context, int taps) : stage_(context), seed_(context.seed), taps_(taps) {}
+    PalmScenario(const ScenarioContext& context, int taps)
+        : stage_(context), seed_(context.seed), taps_(taps) {}
 
     double cycleSeconds() const override { return 2 * kMoveSeconds + taps_ * kTapSeconds; }
 
@@ -416,7 +427,8 @@ public:
         // Rest the palm: the lowest point of palm, thenar and knuckles touches the table.
         double lowest = 1e9;
         for (const HandCapsule& capsule : buildHand(pose).capsules)
-            if (capsule.part == HandPart::Palm || capsule.part == HandPart::Thenar || capsule.part == HandPart::Knuckles)
+            if (capsule.part == HandPart::Palm || capsule.part == HandPart::Thenar ||
+                capsule.part == HandPart::Knuckles)
                 lowest = std::min(lowest, capsule.shape.supportPoint(-Eigen::Vector3d::UnitZ()).z());
         pose.wristToTable.translation().z() -= lowest;
         std::array<Eigen::Vector3d, kFingerCount> natural;
@@ -424,7 +436,8 @@ public:
             natural[f] = fingerPad(pose, static_cast<Finger>(f));
         // The hand comes in and leaves as a whole.
         const double total = cycleSeconds();
-        const double in = smoother(local / kMoveSeconds), out = smoother((local - (total - kMoveSeconds)) / kMoveSeconds);
+        const double in = smoother(local / kMoveSeconds),
+                     out = smoother((local - (total - kMoveSeconds)) / kMoveSeconds);
         const Eigen::Vector3d offset = (stage_.offstage(0.0) - stage_.centre()) * ((1.0 - in) + out);
         pose.wristToTable.translation() += offset;
         // Index height: taps within the resting phase.
@@ -437,7 +450,8 @@ public:
             cv::RNG tapRng = cycleRng(seed_, 50 + tap, cycle);
             tapOffset = Eigen::Vector3d(tapRng.uniform(-8.0, 8.0), tapRng.uniform(-12.0, 4.0), 0.0);
             // Up at 15 mm, down in 0.18 s, dwell 0.25 s, up in 0.25 s.
-            indexHeight = 15.0 * (1.0 - smoother((phase - 0.3) / 0.18)) + 15.0 * smoother((phase - 0.73) / 0.25);
+            indexHeight =
+                15.0 * (1.0 - smoother((phase - 0.3) / 0.18)) + 15.0 * smoother((phase - 0.73) / 0.25);
         }
         for (int f = 0; f < kFingerCount; ++f) {
             pose.presented[f] = true;
@@ -470,7 +484,8 @@ public:
     double cycleSeconds() const override { return contents_ * kContentSeconds; }
     SceneState at(double seconds) const override {
         const long step = static_cast<long>(std::floor(seconds / kContentSeconds));
-        static constexpr std::array<ContentKind, 3> kinds{ContentKind::Photo, ContentKind::Ui, ContentKind::Text};
+        static constexpr std::array<ContentKind, 3> kinds{ContentKind::Photo, ContentKind::Ui,
+                                                          ContentKind::Text};
         SceneState state;
         state.content = kinds[step % kinds.size()];
         state.contentVariant = static_cast<int>(step / static_cast<long>(kinds.size()));
@@ -523,7 +538,8 @@ private:
 }  // namespace
 
 const std::vector<std::string>& scenarioNames() {
-    static const std::vector<std::string> names{"grid35", "drag", "multitouch", "hover", "palm", "idle", "demo"};
+    static const std::vector<std::string> names{"grid35", "drag", "multitouch", "hover",
+                                                "palm",   "idle", "demo"};
     return names;
 }
 

@@ -157,15 +157,17 @@ const std::vector<OptionEntry>& entries() {
         {{"duration", "end the stream after this many seconds (default: endless)"},
          optionalNumber(&SimParameters::durationS)},
         {{"surface", "table surface: gray, yellow or artifacts"},
-         choice(&SimParameters::surface, std::vector<std::pair<std::string, SurfaceKind>>{
-                                             {"gray", SurfaceKind::Gray},
-                                             {"yellow", SurfaceKind::Yellow},
-                                             {"artifacts", SurfaceKind::Artifacts}})},
-        {{"light", "room light preset: dark (3 lux), normal (150 lux), change (normal, dark after "
-                   "ambient_change_s)"},
+         choice(&SimParameters::surface,
+                std::vector<std::pair<std::string, SurfaceKind>>{{"gray", SurfaceKind::Gray},
+                                                                 {"yellow", SurfaceKind::Yellow},
+                                                                 {"artifacts", SurfaceKind::Artifacts}})},
+        {{"light",
+          "room light preset: dark (3 lux), normal (150 lux), change (normal, dark after "
+          "ambient_change_s)"},
          setLight},
-        {{"content", "projected content: auto (the scenario's), grid35, shapes, photo, ui, text, white, gray, "
-                     "or an image file"},
+        {{"content",
+          "projected content: auto (the scenario's), grid35, shapes, photo, ui, text, white, gray, "
+          "or an image file"},
          [](SimParameters& p, std::string_view text) -> std::optional<std::string> {
              if (text.empty())
                  return "expected a content kind or an image file";
@@ -179,14 +181,15 @@ const std::vector<OptionEntry>& entries() {
                                                               {"tan", SkinTone::Tan},
                                                               {"dark", SkinTone::Dark}})},
         {{"camera", "sensor colour: bayer (demosaiced to BGR), rgb or mono"},
-         choice(&SimParameters::cameraColour, std::vector<std::pair<std::string, CameraColour>>{
-                                                  {"bayer", CameraColour::Bayer},
-                                                  {"rgb", CameraColour::Rgb},
-                                                  {"mono", CameraColour::Mono}})},
+         choice(
+             &SimParameters::cameraColour,
+             std::vector<std::pair<std::string, CameraColour>>{
+                 {"bayer", CameraColour::Bayer}, {"rgb", CameraColour::Rgb}, {"mono", CameraColour::Mono}})},
         {{"camera_size", "sensor size WxH, pixels"}, size(&SimParameters::cameraSize)},
         {{"camera_focal_mm", "lens focal length, mm"}, number(&SimParameters::cameraFocalMm)},
         {{"camera_pixel_um", "pixel pitch, micrometres"}, number(&SimParameters::cameraPixelUm)},
-        {{"camera_position", "camera optical centre x:y:z, table mm"}, vector(&SimParameters::cameraPosition)},
+        {{"camera_position", "camera optical centre x:y:z, table mm"},
+         vector(&SimParameters::cameraPosition)},
         {{"camera_target", "table point on the camera's optical axis x:y:z, mm"},
          vector(&SimParameters::cameraTarget)},
         {{"projector_size", "projector panel WxH, pixels"}, size(&SimParameters::projectorSize)},
@@ -243,7 +246,8 @@ const std::vector<OptionEntry>& entries() {
         {{"black_level_dn", "camera black level offset, DN"}, number(&SimParameters::blackLevelDn)},
         {{"prnu", "photo-response non-uniformity, relative rms"}, number(&SimParameters::prnu)},
         {{"camera_defocus_px", "camera blur sigma, pixels"}, number(&SimParameters::cameraDefocusPx)},
-        {{"vignetting_power", "exponent of the cos(field angle) falloff"}, number(&SimParameters::vignettingPower)},
+        {{"vignetting_power", "exponent of the cos(field angle) falloff"},
+         number(&SimParameters::vignettingPower)},
         {{"pixel_samples", "n for n x n samples per camera pixel on the table"},
          integer(&SimParameters::pixelSamples)},
     };
@@ -262,7 +266,8 @@ const std::vector<OptionKey>& optionKeys() {
     return keys;
 }
 
-std::optional<std::string> applyOption(SimParameters& parameters, std::string_view key, std::string_view value) {
+std::optional<std::string> applyOption(SimParameters& parameters, std::string_view key,
+                                       std::string_view value) {
     for (const OptionEntry& entry : entries())
         if (entry.key.name == key)
             return entry.set(parameters, value);

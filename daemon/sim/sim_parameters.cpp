@@ -73,7 +73,8 @@ std::optional<std::string> SimParameters::validate() const {
         return "ambient_change_s: must be >= 0";
     if (!positive(handScale) || handScale < 0.5 || handScale > 1.5)
         return "hand_scale: must be in [0.5, 1.5]";
-    if (!skinScatterMm.allFinite() || (skinScatterMm.array() < 0.0).any() || (skinScatterMm.array() > 10.0).any())
+    if (!skinScatterMm.allFinite() || (skinScatterMm.array() < 0.0).any() ||
+        (skinScatterMm.array() > 10.0).any())
         return "skin_scatter_mm: must be three numbers in [0, 10]";
     if (!fraction(skinScatterFraction))
         return "skin_scatter_fraction: must be in [0, 1]";

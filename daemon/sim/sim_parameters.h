@@ -26,12 +26,12 @@ enum class SkinTone { Light, Medium, Tan, Dark };
 //
 // Table frame: x, y on the table in mm, z up. The rig stands on the far side of the table (y < 0) and looks
 // towards the user, who sits at +y; the user's hands enter the scene from +y. Light is measured in lux of
-// illuminance on the table; "radiance" below means illuminance times albedo (lux), which the camera turns into
-// electrons with `sensitivity`.
+// illuminance on the table; "radiance" below means illuminance times albedo (lux), which the camera turns
+// into electrons with `sensitivity`.
 struct SimParameters {
     // --- session ---
-    std::string scenario = "demo";  // grid35, drag, multitouch, hover, palm, idle or demo
-    std::uint64_t seed = 1;         // every random choice (pattern, content, motion, noise) follows from it
+    std::string scenario = "demo";    // grid35, drag, multitouch, hover, palm, idle or demo
+    std::uint64_t seed = 1;           // every random choice (pattern, content, motion, noise) follows from it
     std::optional<double> durationS;  // the stream ends after this many seconds; endless when not set
     std::string content = "auto";     // procedural content kind (see content.h) or "auto": the scenario's own
 
@@ -42,14 +42,15 @@ struct SimParameters {
     Eigen::Vector3d cameraPosition{-20.0, -215.0, 455.0};  // optical centre, table mm
     Eigen::Vector3d cameraTarget{0.0, 10.0, 0.0};          // table point on the optical axis
     cv::Size projectorSize{640, 480};                      // DLP panel, pixels
-    double projectorFocalPx = 1130.0;                      // focal length, panel pixels (throw ratio ~1.8)
+    double projectorFocalPx = 950.0;                       // focal length, panel pixels (throw ratio ~1.5)
     double projectorPrincipalRowPx = 150.0;  // principal point row: below 240 the lens throws the image away
                                              // from the rig (offset lens), as projectors do
     Eigen::Vector3d projectorPosition{25.0, -210.0, 460.0};  // optical centre, table mm
     Eigen::Vector3d projectorTarget{0.0, 0.0, 0.0};          // table point hit by the panel's centre pixel
     cv::Size displaySize{640, 480};                          // the desktop image, pixels
-    bool keystoneCorrection = true;  // the display fills the largest upright 4:3 rectangle inside the projected
-                                     // quadrilateral (the paper's H_TP); otherwise it is the panel itself
+    bool keystoneCorrection =
+        true;  // the display fills the largest upright 4:3 rectangle inside the projected
+               // quadrilateral (the paper's H_TP); otherwise it is the panel itself
 
     // --- timing and code ---
     double frameRate = 120.0;  // projector refresh = camera frame rate, Hz; frame k shows I (k even) or I'
@@ -58,15 +59,15 @@ struct SimParameters {
     // --- projector photometry ---
     double projectorWhiteLux = 150.0;  // illuminance of full white at the display centre (a ~10 lm DLP pico)
     double projectorGamma = 2.2;       // light = black + (1 - black) * (level / 255)^gamma
-    double projectorBlackLevel = 0.002;   // light at level 0 as a fraction of white (contrast 500:1)
+    double projectorBlackLevel = 0.002;    // light at level 0 as a fraction of white (contrast 500:1)
     double projectorCornerFalloff = 0.85;  // relative illuminance of the panel's corners (lens vignetting)
-    double projectorDefocusPx = 0.5;       // Gaussian sigma of the projector's blur on the table, panel pixels
+    double projectorDefocusPx = 0.5;  // Gaussian sigma of the projector's blur on the table, panel pixels
 
     // --- ambient light ---
-    double ambientLux = 150.0;                          // room light on the table ("normal"; "dark": 3)
-    Eigen::Vector3d ambientColour{1.0, 0.92, 0.78};     // relative R, G, B of the room light (warm white)
-    std::optional<double> ambientChangeLux;             // the room light changes to this level ...
-    double ambientChangeAtS = 20.0;                     // ... at this time into the session, seconds
+    double ambientLux = 150.0;                       // room light on the table ("normal"; "dark": 3)
+    Eigen::Vector3d ambientColour{1.0, 0.92, 0.78};  // relative R, G, B of the room light (warm white)
+    std::optional<double> ambientChangeLux;          // the room light changes to this level ...
+    double ambientChangeAtS = 20.0;                  // ... at this time into the session, seconds
 
     // --- table surface ---
     SurfaceKind surface = SurfaceKind::Gray;  // gray, yellow or artifacts

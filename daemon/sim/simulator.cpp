@@ -46,10 +46,12 @@ Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, co
     } else if (parameters_.content != "auto") {
         fixedKind_ = contentKindFromName(parameters_.content);
         if (!fixedKind_)
-            throw std::invalid_argument("content: \"" + parameters_.content +
-                                        "\" is not a procedural kind (grid35, shapes, photo, ui, text, white, gray)");
+            throw std::invalid_argument(
+                "content: \"" + parameters_.content +
+                "\" is not a procedural kind (grid35, shapes, photo, ui, text, white, gray)");
     }
-    exposureMs_ = parameters_.exposureMs ? *parameters_.exposureMs : renderer_->meterExposureMs(ambientLux(0.0));
+    exposureMs_ =
+        parameters_.exposureMs ? *parameters_.exposureMs : renderer_->meterExposureMs(ambientLux(0.0));
 }
 
 std::optional<std::uint64_t> Simulator::frameCount() const {
@@ -76,7 +78,8 @@ void Simulator::showContent(const SceneState& scene) {
                    : std::pair<ContentKind, int>(scene.content, scene.contentVariant);
     if (shown_ == wanted)
         return;
-    renderer_->setContent(renderContent(wanted.first, calibration_.displaySize, parameters_.seed, wanted.second));
+    renderer_->setContent(
+        renderContent(wanted.first, calibration_.displaySize, parameters_.seed, wanted.second));
     shown_ = wanted;
 }
 

@@ -20,10 +20,11 @@ namespace everytouch::sim {
 class Simulator {
 public:
     // pattern: CV_8UC1, projector size, 0/1. contentImage: when not empty, shown instead of any procedural
-    // content (8-bit gray or BGR, any size: it is scaled to the display). Throws std::invalid_argument when the
-    // parameters are invalid, name an unknown scenario, or name a content that is neither a procedural kind nor
-    // "auto" and no content image is given.
-    Simulator(const SimParameters& parameters, const cv::Mat& pattern, const cv::Mat& contentImage = cv::Mat());
+    // content (8-bit gray or BGR, any size: it is scaled to the display). Throws std::invalid_argument when
+    // the parameters are invalid, name an unknown scenario, or name a content that is neither a procedural
+    // kind nor "auto" and no content image is given.
+    Simulator(const SimParameters& parameters, const cv::Mat& pattern,
+              const cv::Mat& contentImage = cv::Mat());
 
     const SimParameters& parameters() const { return parameters_; }
     const core::Calibration& calibration() const { return calibration_; }

@@ -37,7 +37,9 @@ cv::Mat unevenSurface(cv::Size size, const cv::Vec3f& reflectanceBgr, double une
 
 void addArtifacts(cv::Mat& surface, double mmPerTexel, cv::RNG& rng) {
     const cv::Size size = surface.size();
-    const auto texels = [&](double mm) { return std::max(1, static_cast<int>(std::lround(mm / mmPerTexel))); };
+    const auto texels = [&](double mm) {
+        return std::max(1, static_cast<int>(std::lround(mm / mmPerTexel)));
+    };
     const auto anywhere = [&] { return cv::Point(rng.uniform(0, size.width), rng.uniform(0, size.height)); };
     // Drawing is done in reflectance (0..1) on a float image.
     for (int i = 0; i < 6; ++i) {  // sticky notes and printed sheets
@@ -59,20 +61,25 @@ void addArtifacts(cv::Mat& surface, double mmPerTexel, cv::RNG& rng) {
                    texels(rng.uniform(1.0, 3.0)), cv::LINE_AA);
     for (int i = 0; i < 8; ++i) {  // stains
         cv::Mat stain(size, CV_8UC1, cv::Scalar(0));
-        cv::ellipse(stain, anywhere(), cv::Size(texels(rng.uniform(10.0, 40.0)), texels(rng.uniform(8.0, 30.0))),
+        cv::ellipse(stain, anywhere(),
+                    cv::Size(texels(rng.uniform(10.0, 40.0)), texels(rng.uniform(8.0, 30.0))),
                     rng.uniform(0.0, 180.0), 0, 360, cv::Scalar(255), cv::FILLED);
-        surface.setTo(surface.mul(cv::Scalar(0.75, 0.8, 0.85)), stain);
+        cv::Mat darkened;
+        cv::multiply(surface, cv::Scalar(0.75, 0.8, 0.85), darkened);
+        darkened.copyTo(surface, stain);
     }
     for (int i = 0; i < 12; ++i) {  // ink scribbles
         std::vector<cv::Point> stroke{anywhere()};
         for (int s = 0; s < 12; ++s)
-            stroke.push_back(stroke.back() + cv::Point(texels(rng.uniform(-12.0, 12.0)), texels(rng.uniform(-12.0, 12.0))));
+            stroke.push_back(stroke.back() +
+                             cv::Point(texels(rng.uniform(-12.0, 12.0)), texels(rng.uniform(-12.0, 12.0))));
         cv::polylines(surface, stroke, false, cv::Scalar(0.45, 0.15, 0.10), texels(0.8), cv::LINE_AA);
     }
     for (int i = 0; i < 30; ++i) {  // scratches, lighter or darker than the surface
         const cv::Point start = anywhere();
         const double angle = rng.uniform(0.0, M_PI), length = rng.uniform(20.0, 120.0);
-        const cv::Point end = start + cv::Point(texels(length * std::cos(angle)), texels(length * std::sin(angle)));
+        const cv::Point end =
+            start + cv::Point(texels(length * std::cos(angle)), texels(length * std::sin(angle)));
         const double shade = rng.uniform(0, 2) ? 0.9 : 0.45;
         cv::line(surface, start, end, cv::Scalar::all(shade), 1, cv::LINE_AA);
     }
@@ -80,7 +87,8 @@ void addArtifacts(cv::Mat& surface, double mmPerTexel, cv::RNG& rng) {
 
 }  // namespace
 
-SurfaceTexture makeSurface(SurfaceKind kind, const cv::Rect2d& areaMm, double mmPerTexel, std::uint64_t seed) {
+SurfaceTexture makeSurface(SurfaceKind kind, const cv::Rect2d& areaMm, double mmPerTexel,
+                           std::uint64_t seed) {
     cv::RNG rng(seed * 2654435761u + static_cast<std::uint64_t>(kind) + 17);
     const cv::Size size(static_cast<int>(std::ceil(areaMm.width / mmPerTexel)) + 1,
                         static_cast<int>(std::ceil(areaMm.height / mmPerTexel)) + 1);

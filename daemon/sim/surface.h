@@ -12,8 +12,8 @@ namespace everytouch::sim {
 // Albedo of the table top: linear reflectance per channel (BGR, 0..1 stored as 0..255) on a regular grid of
 // the table plane.
 struct SurfaceTexture {
-    cv::Mat albedo;                                                 // CV_8UC3, linear reflectance x 255
-    Eigen::Matrix3d tableToTexel = Eigen::Matrix3d::Identity();     // table mm -> texel coordinates
+    cv::Mat albedo;                                              // CV_8UC3, linear reflectance x 255
+    Eigen::Matrix3d tableToTexel = Eigen::Matrix3d::Identity();  // table mm -> texel coordinates
 };
 
 // A table top covering `areaMm` (x, y, width, height in table mm) at `mmPerTexel`: uniform gray or yellow
