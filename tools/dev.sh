@@ -41,7 +41,7 @@ build() {
     cmake --build "$dir" -j "$jobs"
 }
 
-cpp_files() { git ls-files '*.cpp' '*.h' ; }
+cpp_files() { git ls-files --cached --others --exclude-standard '*.cpp' '*.h'; }
 
 command=${1:-}
 [ $# -gt 0 ] && shift
@@ -58,7 +58,8 @@ test)
     ;;
 sanitize)
     install_missing_packages
-    build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF
+    # Warnings are enforced by the normal build; GCC's flow analysis under ASan reports false positives.
+    build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF -DEVERYTOUCH_WERROR=OFF
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
         ctest --test-dir build-sanitize --output-on-failure -j "$jobs" "$@"
     ;;
