@@ -41,7 +41,8 @@ int run(const everytouch::service::DaemonOptions& options) {
         const std::optional<io::RigDescription> rig = source->rig();
         if (!rig)
             throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
-        recorder = std::make_unique<io::RecordingWriter>(options.recordDir, *rig, false);
+        recorder =
+            std::make_unique<io::RecordingWriter>(options.recordDir, *rig, source->truth().has_value());
     }
 
     io::ConsoleSink console;

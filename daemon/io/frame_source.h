@@ -2,7 +2,9 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "core/contact.h"
 #include "core/frame.h"
 #include "io/rig_description.h"
 
@@ -21,6 +23,10 @@ public:
     virtual std::optional<RigDescription> rig() const = 0;
 
     virtual std::string describe() const = 0;
+
+    // Ground truth of the frame `next` returned last, when the source knows it (the simulator): one entry per
+    // finger the scene presents, possibly none. Nothing for sources without ground truth.
+    virtual std::optional<std::vector<core::FingerTruth>> truth() const { return std::nullopt; }
 };
 
 }  // namespace everytouch::io

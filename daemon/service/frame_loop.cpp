@@ -26,8 +26,11 @@ LoopStatistics FrameLoop::run(const std::atomic<bool>& stop) {
         ++statistics.frames;
         lastIndex = frame->index;
         lastTimestampUs = frame->timestampUs;
-        if (recorder_)
+        if (recorder_) {
             recorder_->addFrame(*frame);
+            if (const auto truth = source_.truth())
+                recorder_->addTruth(*truth);
+        }
         if (std::optional<core::FramePair> pair = pairer_.push(*frame)) {
             ++statistics.pairs;
             // Detection stages plug in here; until they exist no finger is ever reported.

@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "io/replay_source.h"
+#include "io/sim_source.h"
 
 namespace everytouch::service {
 
@@ -10,9 +11,7 @@ std::unique_ptr<io::FrameSource> openFrameSource(const io::RigSpec& spec, bool f
         case io::RigSpec::Kind::Replay:
             return std::make_unique<io::ReplaySource>(spec.target, !fast);
         case io::RigSpec::Kind::Sim:
-            throw io::InputError(
-                "--rig " + spec.toString(), "",
-                "the simulated rig is not part of this build yet; use replay:DIR with a recording");
+            return std::make_unique<io::SimSource>(spec, !fast);
         case io::RigSpec::Kind::Aravis:
         case io::RigSpec::Kind::V4l2:
             throw io::InputError("--rig " + spec.toString(), "",

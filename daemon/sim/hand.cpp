@@ -141,12 +141,12 @@ void HandPose::place(const Eigen::Vector3d& wrist, double yawDeg, double pitchDe
 FingerJoints curledJoints(Finger finger) {
     if (finger == Finger::Thumb)
         return {-15.0, {35.0, 45.0, 30.0}};
-    return {0.0, {75.0, 95.0, 65.0}};
+    return {0.0, {85.0, 100.0, 60.0}};
 }
 
 FingerJoints pointingJoints(Finger finger) {
     if (finger == Finger::Index)
-        return {0.0, {8.0, 16.0, 11.0}};
+        return {0.0, {0.0, 12.0, 8.0}};
     return curledJoints(finger);
 }
 

@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kHoverMm = 35.0;      // height of a finger travelling between taps
 constexpr double kEnterSeconds = 1.0;  // a hand coming into view or leaving it
-constexpr double kPointingPitchDeg = 15.0;
+constexpr double kPointingPitchDeg = 30.0;
 constexpr double kUserYawDeg = -90.0;  // a hand of the user at +y points towards -y
 
 double smoother(double x) {

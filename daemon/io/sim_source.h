@@ -1,0 +1,43 @@
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/frame_source.h"
+#include "io/rig_spec.h"
+#include "sim/renderer.h"
+#include "sim/simulator.h"
+
+namespace everytouch::io {
+
+// The simulated rig as a frame source (`--rig sim[:SCENARIO][,key=value...]`): frames at the camera's rate
+// with alternating polarity, paced in real time unless asked to run fast, with the ground truth of each.
+class SimSource final : public FrameSource {
+public:
+    // Throws InputError naming the --rig spec and the key at fault (unknown scenario or key, bad value,
+    // unreadable content image).
+    SimSource(const RigSpec& spec, bool paced);
+
+    std::optional<core::Frame> next() override;
+    std::optional<RigDescription> rig() const override;
+    std::string describe() const override;
+    std::optional<std::vector<core::FingerTruth>> truth() const override;
+
+    // Everything the renderer knows about the last frame: every fingertip, the hand mask, visible heights.
+    const sim::FrameTruth& frameTruth() const { return truth_; }
+    const sim::Simulator& simulator() const { return *simulator_; }
+
+private:
+    std::string spec_;
+    std::unique_ptr<sim::Simulator> simulator_;
+    bool paced_;
+    std::uint64_t index_ = 0;
+    std::chrono::steady_clock::time_point start_;
+    sim::FrameTruth truth_;
+    std::uint64_t truthIndex_ = 0;
+};
+
+}  // namespace everytouch::io
