@@ -42,7 +42,7 @@ const std::array<FingerAnatomy, kFingerCount>& anatomy() {
          {14, 12.5, 11},
          0.7,
          {-25, 25},
-         {-30, 95},
+         {-10, 95},
          {0, 110}},
         {{96, 6, 1},
          0,
@@ -53,7 +53,7 @@ const std::array<FingerAnatomy, kFingerCount>& anatomy() {
          {14.5, 13, 11.5},
          0.7,
          {-25, 25},
-         {-30, 95},
+         {-10, 95},
          {0, 110}},
         {{91, -12, 0},
          -4,
@@ -64,7 +64,7 @@ const std::array<FingerAnatomy, kFingerCount>& anatomy() {
          {14, 12.5, 11},
          0.7,
          {-25, 25},
-         {-30, 95},
+         {-10, 95},
          {0, 110}},
         {{80, -29, -2},
          -9,
@@ -75,7 +75,7 @@ const std::array<FingerAnatomy, kFingerCount>& anatomy() {
          {12.5, 11, 10},
          0.7,
          {-25, 25},
-         {-30, 95},
+         {-10, 95},
          {0, 110}},
     }};
     return fingers;
@@ -204,15 +204,18 @@ double reachPad(HandPose& pose, Finger finger, const Eigen::Vector3d& target) {
         joints.abductionDeg = q[0];
         joints.flexionDeg = {q[1], q[2], q[2] * a.lastJointCoupling};
     };
+    // Height matters most: a finger that cannot reach the target's place still touches (or hovers) at the
+    // target's height.
+    const Eigen::Vector3d weight(1.0, 1.0, 10.0);
     auto residual = [&](const Eigen::Vector3d& q) {
         apply(q);
-        return Eigen::Vector3d(fingerPad(pose, finger) - target);
+        return Eigen::Vector3d((fingerPad(pose, finger) - target).cwiseProduct(weight));
     };
     Eigen::Vector3d q(joints.abductionDeg, joints.flexionDeg[0], joints.flexionDeg[1]);
     clampJoints(q);
     Eigen::Vector3d r = residual(q);
     double damping = 1e-3;
-    for (int iteration = 0; iteration < 40 && r.norm() > 1e-7; ++iteration) {
+    for (int iteration = 0; iteration < 60 && r.norm() > 1e-7; ++iteration) {
         Eigen::Matrix3d jacobian;
         constexpr double kStepDeg = 1e-3;
         for (int i = 0; i < 3; ++i) {
@@ -238,7 +241,7 @@ double reachPad(HandPose& pose, Finger finger, const Eigen::Vector3d& target) {
         }
     }
     apply(q);
-    return r.norm();
+    return (fingerPad(pose, finger) - target).norm();
 }
 
 void movePadTo(HandPose& pose, Finger finger, const Eigen::Vector3d& target) {

@@ -65,7 +65,8 @@ HandModel buildHand(const HandPose& pose);
 Eigen::Vector3d fingerPad(const HandPose& pose, Finger finger);
 
 // Bends `finger` (abduction, first and second flexion; the third follows the second) so that its pad lands
-// on `target` as closely as the joint limits allow. Returns the remaining distance, mm.
+// on `target` as closely as the joint limits allow, the height before the place. Returns the remaining
+// distance, mm.
 double reachPad(HandPose& pose, Finger finger, const Eigen::Vector3d& target);
 
 // Moves the whole hand so that the pad of `finger` lands exactly on `target`.

@@ -39,7 +39,7 @@ struct FrameTruth {
 
 // Touch tolerance of the ground truth: a pad closer to the table than this counts as touching (skin deforms
 // far more than this under the lightest touch).
-inline constexpr double kContactToleranceMm = 0.01;
+inline constexpr double kContactToleranceMm = 0.1;
 
 // Ray-casting renderer of table, projector, hands and camera. Everything that does not move is precomputed:
 // the table's image for each projected image (per camera pixel, integrated over the pixel), the light the

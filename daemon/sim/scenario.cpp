@@ -332,7 +332,7 @@ public:
         switch (gesture) {
             case 0:  // pinch: thumb and index close in
                 state.hands.push_back(gestureHand(centre, yaw, false, {Finger::Thumb, Finger::Index},
-                                                  1.15 - 0.75 * act, 0.0, height, offset));
+                                                  1.1 - 0.55 * act, 0.0, height, offset));
                 break;
             case 1:  // spread: five fingers move apart
                 state.hands.push_back(
@@ -383,15 +383,31 @@ private:
             meanHeight += pad.z();
         meanHeight /= static_cast<double>(natural.size());
         const Eigen::AngleAxisd turn(turnDeg * M_PI / 180.0, Eigen::Vector3d::UnitZ());
-        Eigen::Isometry3d wrist = pose.wristToTable;
-        wrist.translation().z() += heightMm - meanHeight - 4.0;
-        wrist = Eigen::Translation3d(centroid + offset) * turn * Eigen::Translation3d(-centroid) * wrist;
-        pose.wristToTable = wrist;
         for (int f = 0; f < kFingerCount; ++f)
             pose.fingers[f] = curledJoints(static_cast<Finger>(f));
+        std::array<bool, kFingerCount> acting{};
+        for (Finger finger : fingers) {
+            acting[static_cast<int>(finger)] = true;
+            pose.fingers[static_cast<int>(finger)] = relaxedJoints(finger);
+        }
+        // Keep the palm and the curled fingers clear of the table; the acting fingers reach down to it.
+        double lowestRest = 1e9;
+        const HandModel model = buildHand(pose);
+        for (size_t i = 0; i < model.capsules.size(); ++i) {
+            const int finger =
+                i < 4 ? -1 : static_cast<int>(i - 4) / 3;  // forearm, palm, knuckles, thenar first
+            if (finger < 0 || !acting[finger])
+                lowestRest =
+                    std::min(lowestRest, model.capsules[i].shape.supportPoint(-Eigen::Vector3d::UnitZ()).z());
+        }
+        constexpr double kClearanceMm = 6.0;
+        Eigen::Isometry3d wrist = pose.wristToTable;
+        wrist.translation().z() +=
+            heightMm + std::max(kClearanceMm - (lowestRest - meanHeight), -4.0) - meanHeight;
+        wrist = Eigen::Translation3d(centroid + offset) * turn * Eigen::Translation3d(-centroid) * wrist;
+        pose.wristToTable = wrist;
         for (size_t i = 0; i < fingers.size(); ++i) {
             const int f = static_cast<int>(fingers[i]);
-            pose.fingers[f] = relaxedJoints(fingers[i]);
             pose.presented[f] = true;
             Eigen::Vector3d target = centroid + turn * (natural[i] - centroid) * spread;
             target.z() = heightMm;
@@ -424,11 +440,10 @@ public:
             stage_.centre() + Eigen::Vector3d(rng.uniform(-50.0, 50.0), rng.uniform(0.0, 40.0), 0.0);
         HandPose pose = relaxedHand(Eigen::Vector3d::Zero(), yaw, -4.0, false, stage_.handScale());
         pose.place(wristFor(pose, where), yaw, -4.0);
-        // Rest the palm: the lowest point of palm, thenar and knuckles touches the table.
+        // Rest the hand: the lowest point of palm, thenar, knuckles and wrist touches the table.
         double lowest = 1e9;
         for (const HandCapsule& capsule : buildHand(pose).capsules)
-            if (capsule.part == HandPart::Palm || capsule.part == HandPart::Thenar ||
-                capsule.part == HandPart::Knuckles)
+            if (capsule.part != HandPart::Bone && capsule.part != HandPart::Fingertip)
                 lowest = std::min(lowest, capsule.shape.supportPoint(-Eigen::Vector3d::UnitZ()).z());
         pose.wristToTable.translation().z() -= lowest;
         std::array<Eigen::Vector3d, kFingerCount> natural;
