@@ -1,5 +1,6 @@
 #include "sim/camera_sensor.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgproc.hpp>
@@ -70,44 +71,42 @@ void CameraSensor::expose(const cv::Mat& radiance, double exposureMs, std::uint6
                           cv::Mat& image) {
     CV_Assert(radiance.type() == CV_32FC3 && radiance.size() == chargeGain_.size());
     const cv::Size size = radiance.size();
-    // The light each pixel's colour filter lets through.
-    const cv::Mat* light = &radiance;
-    if (colour_ != CameraColour::Rgb) {
-        filtered_.create(size, CV_32FC1);
-        for (int y = 0; y < size.height; ++y) {
-            const float* in = radiance.ptr<float>(y);
-            float* out = filtered_.ptr<float>(y);
-            if (colour_ == CameraColour::Mono) {
-                for (int x = 0; x < size.width; ++x)
-                    out[x] = monoWeights_[0] * in[3 * x] + monoWeights_[1] * in[3 * x + 1] +
-                             monoWeights_[2] * in[3 * x + 2];
-            } else {
-                const int even = mosaicChannel(0, y), odd = mosaicChannel(1, y);
-                for (int x = 0; x + 1 < size.width; x += 2) {
-                    out[x] = in[3 * x + even];
-                    out[x + 1] = in[3 * x + 3 + odd];
-                }
-                if (size.width % 2)
-                    out[size.width - 1] = in[3 * (size.width - 1) + even];
-            }
-        }
-        light = &filtered_;
-    }
-    // Charge: signal, shot noise (Poisson, as a Gaussian of the same variance) and read noise, then the full
-    // well; digital value: gain and white balance, black level, 8-bit rounding and clipping.
-    cv::multiply(*light, chargeGain_, charge_, exposureMs);
-    cv::max(charge_, 0.0, charge_);
-    noise_.create(charge_.size(), charge_.type());
+    const bool mosaic = colour_ != CameraColour::Rgb;
+    const int values = mosaic ? size.width : 3 * size.width;
+    noise_.create(size, chargeGain_.type());
     cv::RNG rng(noiseSeed);
     rng.fill(noise_, cv::RNG::NORMAL, 0.0, 1.0);
-    cv::add(charge_, cv::Scalar::all(readNoise_ * readNoise_), sigma_);
-    cv::sqrt(sigma_, sigma_);
-    cv::multiply(sigma_, noise_, sigma_);
-    charge_ += sigma_;
-    cv::min(charge_, fullWell_, charge_);
-    cv::max(charge_, 0.0, charge_);
-    cv::multiply(charge_, dnGain_, charge_);
-    charge_.convertTo(raw_, CV_8U, 1.0, blackLevel_);
+    raw_.create(size, CV_MAKETYPE(CV_8U, mosaic ? 1 : 3));
+    filtered_.create(1, values, CV_32F);
+    const float exposure = static_cast<float>(exposureMs), fullWell = static_cast<float>(fullWell_);
+    const float read2 = static_cast<float>(readNoise_ * readNoise_), black = static_cast<float>(blackLevel_);
+    for (int y = 0; y < size.height; ++y) {
+        // The light each pixel's colour filter lets through.
+        const float* in = radiance.ptr<float>(y);
+        float* light = filtered_.ptr<float>();
+        if (colour_ == CameraColour::Mono) {
+            for (int x = 0; x < size.width; ++x)
+                light[x] = monoWeights_[0] * in[3 * x] + monoWeights_[1] * in[3 * x + 1] +
+                           monoWeights_[2] * in[3 * x + 2];
+        } else if (colour_ == CameraColour::Bayer) {
+            const int even = mosaicChannel(0, y), odd = mosaicChannel(1, y);
+            for (int x = 0; x < size.width; ++x)
+                light[x] = in[3 * x + (x % 2 ? odd : even)];
+        } else {
+            std::copy(in, in + values, light);
+        }
+        // Charge: signal, shot noise (Poisson, as a Gaussian of the same variance) and read noise, then the
+        // full well; digital value: gain and white balance, black level, 8-bit rounding and clipping.
+        const float* gain = chargeGain_.ptr<float>(y);
+        const float* toDn = dnGain_.ptr<float>(y);
+        const float* noise = noise_.ptr<float>(y);
+        uchar* out = raw_.ptr<uchar>(y);
+        for (int i = 0; i < values; ++i) {
+            const float charge = std::max(0.0f, light[i] * gain[i] * exposure);
+            const float noisy = std::clamp(charge + std::sqrt(charge + read2) * noise[i], 0.0f, fullWell);
+            out[i] = cv::saturate_cast<uchar>(noisy * toDn[i] + black);
+        }
+    }
     if (colour_ == CameraColour::Bayer)
         cv::cvtColor(raw_, image, cv::COLOR_BayerBG2BGR);
     else

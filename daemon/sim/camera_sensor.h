@@ -43,7 +43,7 @@ private:
     double centreGain_[3];  // white-balanced DN per lux-millisecond at the image centre
     float monoWeights_[3];  // a monochrome pixel's response to B, G, R light
     // Per-frame buffers.
-    cv::Mat filtered_, charge_, noise_, sigma_, raw_;
+    cv::Mat filtered_, noise_, raw_;
 };
 
 }  // namespace everytouch::sim

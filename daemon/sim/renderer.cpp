@@ -266,6 +266,7 @@ void Renderer::setContent(const cv::Mat& displayContent) {
         cv::merge(std::vector<cv::Mat>{tableIncidence_, tableIncidence_, tableIncidence_}, incidence3);
         projected_[polarity] = accumulated.mul(albedo_).mul(incidence3);
         blurIfNeeded(projected_[polarity], projectedBlurred_[polarity], p.cameraDefocusPx);
+        ++contentVersion_;
 
         // Skin: part of the light is reflected at the surface, the rest leaves after spreading under the skin
         // (red farthest). Both seen through the camera pixel's footprint.
@@ -446,20 +447,23 @@ void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv:
             Eigen::Vector3f shadeDirection = pixelToRay * Eigen::Vector3f(x, y, 1.0f);
             float coverage = hit ? 1.0f : 0.0f;
             if (edge) {
-                // Integrate the silhouette over the pixel with four samples.
+                // Integrate the silhouette over the pixel with four samples, against the capsules seen by the
+                // pixel and its neighbours.
+                short candidates[5] = {index[x], index[left], index[right], above[x], below[x]};
                 int hits = 0;
                 for (int s = 0; s < 4; ++s) {
                     const Eigen::Vector3f pixel(x + ((s & 1) ? 0.25f : -0.25f),
                                                 y + ((s & 2) ? 0.25f : -0.25f), 1.0f);
                     float best = kNoHit;
                     int bestIndex = -1;
-                    for (size_t k = 0; k < capsules.size(); ++k) {
-                        if (!capsules[k].cameraBox.contains({x, y}))
+                    for (int c = 0; c < 5; ++c) {
+                        const short k = candidates[c];
+                        if (k < 0 || (c > 0 && std::find(candidates, candidates + c, k) != candidates + c))
                             continue;
                         const float t =
                             capsules[k].camera.intersectLocal(capsules[k].cameraPixelToLocal * pixel);
                         if (t > 0.0f && t < best)
-                            best = t, bestIndex = static_cast<int>(k);
+                            best = t, bestIndex = k;
                     }
                     if (bestIndex < 0)
                         continue;
@@ -538,9 +542,22 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
             truth.fingertips.push_back(tip);
         }
     }
-    // The table as precomputed, camera blur included; then, where hands and their shadows change it, the
-    // same computed again from the unblurred table with them, and blurred.
-    cv::scaleAdd(ambientBlurred_, ambientLux, projectedBlurred_[polarityIndex], blurred_);
+    // The table as precomputed, camera blur included, kept per polarity: only what the hands changed in the
+    // last frame of this polarity is restored. Then, where hands and their shadows change the table, the same
+    // is computed again from the unblurred table with them, and blurred.
+    cv::Mat& frame = frameRadiance_[polarityIndex];
+    cv::Rect& dirty = dirty_[polarityIndex];
+    if (frame.empty() || frameAmbientLux_[polarityIndex] != ambientLux ||
+        frameContentVersion_[polarityIndex] != contentVersion_) {
+        cv::scaleAdd(ambientBlurred_, ambientLux, projectedBlurred_[polarityIndex], frame);
+        frameAmbientLux_[polarityIndex] = ambientLux;
+        frameContentVersion_[polarityIndex] = contentVersion_;
+    } else if (dirty.area() > 0) {
+        cv::scaleAdd(ambientBlurred_(dirty), ambientLux, projectedBlurred_[polarityIndex](dirty),
+                     frame(dirty));
+    }
+    dirty = cv::Rect();
+    lastPolarity_ = polarityIndex;
     castShadows(capsules, projectorBox);
     const cv::Rect shadowBox = shadowOnTable(shadowBox_);
     const cv::Rect changed = cameraBox | shadowBox;
@@ -560,9 +577,10 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
         shadeTable(shadowBox, projected_[polarityIndex]);
         castHands(capsules, cameraBox, polarityIndex, ambientLux, truth);
         blurIfNeeded(radiance_(inputPart), partBlurred_, parameters_.cameraDefocusPx);
-        partBlurred_(blurredPart - inputPart.tl()).copyTo(blurred_(blurredPart));
+        partBlurred_(blurredPart - inputPart.tl()).copyTo(frame(blurredPart));
+        dirty = blurredPart;
     }
-    sensor_.expose(blurred_, exposureMs, noiseSeed, image);
+    sensor_.expose(frame, exposureMs, noiseSeed, image);
 }
 
 }  // namespace everytouch::sim

@@ -63,7 +63,7 @@ public:
     double meterExposureMs(double ambientLux) const;
 
     // The noise-free radiance (BGR lux) of the last render, after the camera blur: for tests.
-    const cv::Mat& radiance() const { return blurred_; }
+    const cv::Mat& radiance() const { return frameRadiance_[lastPolarity_]; }
     const CameraSensor& sensor() const { return sensor_; }
 
 private:
@@ -111,7 +111,14 @@ private:
     cv::Mat depth_;     // CV_32FC1, camera size: nearest hand hit per pixel
     cv::Mat hitIndex_;  // CV_16SC1: capsule of that hit, -1 for none
     cv::Mat radiance_;  // CV_32FC3, camera size: unblurred radiance, valid where hands changed it
-    cv::Mat blurred_;   // CV_32FC3, camera size: radiance through the camera's blur
+    // Per polarity, CV_32FC3, camera size: the last frame's radiance through the camera's blur, the region
+    // the hands changed in it, and the ambient level and content it was made for.
+    cv::Mat frameRadiance_[2];
+    cv::Rect dirty_[2];
+    double frameAmbientLux_[2] = {-1.0, -1.0};
+    int frameContentVersion_[2] = {-1, -1};
+    int contentVersion_ = 0;
+    int lastPolarity_ = 0;
     cv::Mat partBlurred_;
     cv::Mat blockedOnTable_;  // CV_32FC1: shadow mask in camera pixels of the shadow's region
     cv::Mat work_[4];         // content precomputation

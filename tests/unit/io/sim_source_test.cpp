@@ -1,0 +1,100 @@
+#include "io/sim_source.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "io/input_error.h"
+#include "support/temp_dir.h"
+
+namespace everytouch::io {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string errorOf(const std::string& spec) {
+    try {
+        SimSource source(RigSpec::parse(spec), false);
+    } catch (const InputError& error) {
+        return error.what();
+    }
+    return "no error";
+}
+
+TEST(SimSource, DeliversAlternatingFramesAtTheCameraRateUntilTheDurationEnds) {
+    SimSource source(RigSpec::parse("sim:grid35,seed=4,duration=0.05"), false);
+    std::vector<core::Frame> frames;
+    while (std::optional<core::Frame> frame = source.next())
+        frames.push_back(*frame);
+    ASSERT_EQ(frames.size(), 6u);  // 0.05 s at 120 Hz
+    for (size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_EQ(frames[i].index, i);
+        EXPECT_EQ(frames[i].polarity, i % 2 ? core::Polarity::Negative : core::Polarity::Positive);
+        EXPECT_NEAR(frames[i].timestampUs, i * 1e6 / 120.0, 0.5);
+        EXPECT_EQ(frames[i].image.type(), CV_8UC3);
+        EXPECT_EQ(frames[i].image.size(), cv::Size(648, 488));
+    }
+    const std::optional<RigDescription> rig = source.rig();
+    ASSERT_TRUE(rig);
+    EXPECT_EQ(rig->calibration.validate(), std::nullopt);
+    EXPECT_EQ(rig->pattern.size(), rig->calibration.projectorSize);
+    EXPECT_EQ(rig->delta, 10);
+    EXPECT_EQ(rig->frameRate, 120.0);
+}
+
+TEST(SimSource, ReportsTheTruthOfThePresentedFingers) {
+    SimSource source(RigSpec::parse("sim:drag,seed=2"), false);
+    std::optional<core::Frame> frame;
+    for (int i = 0; i < 230; ++i)  // into the first drag, where the finger is down
+        frame = source.next();
+    const std::optional<std::vector<core::FingerTruth>> truth = source.truth();
+    ASSERT_TRUE(truth);
+    ASSERT_EQ(truth->size(), 1u);  // the pointing index finger
+    EXPECT_EQ(truth->front().frameIndex, frame->index);
+    EXPECT_EQ(truth->front().id, 1u);
+    EXPECT_EQ(truth->front().heightMm, 0.0);
+    EXPECT_GT(truth->front().x, 0.0);
+    EXPECT_LT(truth->front().x, 640.0);
+}
+
+TEST(SimSource, IdleSceneHasTruthWithoutFingers) {
+    SimSource source(RigSpec::parse("sim:idle"), false);
+    ASSERT_TRUE(source.next());
+    ASSERT_TRUE(source.truth());
+    EXPECT_TRUE(source.truth()->empty());
+}
+
+TEST(SimSource, PacesInRealTimeUnlessFast) {
+    SimSource source(RigSpec::parse("sim:idle,duration=0.1"), true);
+    const auto start = std::chrono::steady_clock::now();
+    int frames = 0;
+    while (source.next())
+        ++frames;
+    EXPECT_EQ(frames, 12);
+    EXPECT_GE(std::chrono::steady_clock::now() - start, std::chrono::microseconds(11 * 8333));
+}
+
+TEST(SimSource, ShowsAnImageFileAsContent) {
+    test::TempDir dir;
+    const std::string file = (dir / "red.png").string();
+    ASSERT_TRUE(cv::imwrite(file, cv::Mat(60, 80, CV_8UC3, cv::Scalar(0, 0, 255))));
+    SimSource source(RigSpec::parse("sim:idle,light=dark,content=" + file), false);
+    const std::optional<core::Frame> frame = source.next();
+    ASSERT_TRUE(frame);
+    // The middle of the display is red.
+    const cv::Scalar mean = cv::mean(frame->image(cv::Rect(300, 220, 40, 40)));
+    EXPECT_GT(mean[2], 2.0 * mean[1]);
+}
+
+TEST(SimSource, BadSpecsAreInputErrorsNamingTheKey) {
+    EXPECT_THAT(errorOf("sim:juggle"), HasSubstr("unknown scenario \"juggle\""));
+    EXPECT_THAT(errorOf("sim:demo,noise=3"), HasSubstr("--rig sim:demo,noise=3: noise: unknown key"));
+    EXPECT_THAT(errorOf("sim:demo,seed=x"), HasSubstr("seed: expected a non-negative integer"));
+    EXPECT_THAT(errorOf("sim:demo,delta=500"), HasSubstr("delta: must be in 1..127"));
+    EXPECT_THAT(errorOf("sim:demo,content=/nonexistent.png"),
+                HasSubstr("content: \"/nonexistent.png\" is neither a procedural kind"));
+}
+
+}  // namespace
+}  // namespace everytouch::io
