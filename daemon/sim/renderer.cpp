@@ -383,8 +383,9 @@ void Renderer::shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& d
     const float cosine = normal.dot(toProjector) / std::sqrt(distance2);
     if (q.z() > 0.0f && cosine > 0.0f) {
         const float u = q.x() / q.z(), v = q.y() / q.z();
-        const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
-        const bool inside = iu >= 0 && iv >= 0 && iu < shadowDepth_.cols && iv < shadowDepth_.rows;
+        const bool inside =
+            u > -0.5f && v > -0.5f && u < shadowDepth_.cols - 0.5f && v < shadowDepth_.rows - 0.5f;
+        const int iu = static_cast<int>(u + 0.5f), iv = static_cast<int>(v + 0.5f);
         float light[3];
         if (inside && shadowDepth_.at<float>(iv, iu) >= q.z() - kShadowBiasMm &&
             sampleBilinear<3>(skinLight_[polarityIndex], u, v, light)) {
