@@ -1,5 +1,5 @@
-// everytouch-ber: bit-error rate of the code binarisation on synthetic captures, against the code amplitude delta
-// and the camera noise, as a Markdown table (docs/structured-light.md).
+// everytouch-ber: bit-error rate of the code binarisation on synthetic captures, against the code amplitude
+// delta and the camera noise, as a Markdown table (docs/structured-light.md).
 #include <cstdio>
 #include <vector>
 
@@ -17,8 +17,8 @@ namespace {
 using namespace everytouch;
 
 struct Figures {
-    double bitErrorRate = 0;   // wrong bits / known bits, over projector pixels the camera sees
-    double unknownRate = 0;    // unknown bits / bits
+    double bitErrorRate = 0;        // wrong bits / known bits, over projector pixels the camera sees
+    double unknownRate = 0;         // unknown bits / bits
     double tableMismatches = 0;     // mean Hamming distance of a window through the table's homography
     double tableKnown = 0;          // mean known bits of a window
     double elevatedMismatches = 0;  // mean Hamming distance through the homography of a plane 10 mm higher
@@ -38,14 +38,15 @@ cv::Mat visibleProjectorPixels(const core::Calibration& calibration, int margin)
     return visible;
 }
 
-Figures measure(const test::SyntheticScene& scene, const core::Calibration& calibration, const cv::Mat& visible,
-                const core::BinarizationOptions& binarization) {
+Figures measure(const test::SyntheticScene& scene, const core::Calibration& calibration,
+                const cv::Mat& visible, const core::BinarizationOptions& binarization) {
     const int window = 6;
     cv::Mat subtraction, texture, localMean, codeImage;
     core::computeSubtractionAndTexture(test::renderCapture(scene), subtraction, texture);
     core::binarizeSubtraction(subtraction, scene.grayCamera ? 1 : 3, binarization, localMean, codeImage);
     core::WindowAgreement onTable, elevated;
-    core::matchAllWindows(codeImage, calibration.projectorToCameraHomography(0.0), scene.pattern, window, onTable);
+    core::matchAllWindows(codeImage, calibration.projectorToCameraHomography(0.0), scene.pattern, window,
+                          onTable);
     core::matchAllWindows(codeImage, calibration.projectorToCameraHomography(10.0), scene.pattern, window,
                           elevated);
 
@@ -85,11 +86,13 @@ int main(int argc, char** argv) {
     double lensMm = 6.0;
     bool gray = false;
     core::BinarizationOptions binarization;
-    app.add_option("--lens-mm", lensMm, "camera focal length, mm (6: the paper-like rig)")->check(CLI::PositiveNumber);
+    app.add_option("--lens-mm", lensMm, "camera focal length, mm (6: the paper-like rig)")
+        ->check(CLI::PositiveNumber);
     app.add_flag("--gray", gray, "a gray camera instead of a colour one");
     app.add_option("--neighbourhood", binarization.neighbourhood, "binarisation neighbourhood, camera px");
     app.add_option("--mixture-margin", binarization.mixtureMargin, "binarisation mixture margin");
-    app.add_option("--max-error-probability", binarization.maxErrorProbability, "binarisation: unknown above");
+    app.add_option("--max-error-probability", binarization.maxErrorProbability,
+                   "binarisation: unknown above");
     app.add_option("--min-amplitude-sigmas", binarization.minAmplitudeSigmas, "binarisation: unknown below");
     CLI11_PARSE(app, argc, argv);
 
@@ -103,17 +106,20 @@ int main(int argc, char** argv) {
     scene.grayCamera = gray;
     const cv::Mat visible = visibleProjectorPixels(calibration, binarization.neighbourhood);
     const Eigen::Matrix3d h = calibration.projectorToCameraHomography(0.0);
-    const Eigen::Vector2d centre(calibration.projectorSize.width / 2.0, calibration.projectorSize.height / 2.0);
-    const double scale = (core::applyHomography(h, centre + Eigen::Vector2d(1, 0)) -
-                          core::applyHomography(h, centre)).norm();
+    const Eigen::Vector2d centre(calibration.projectorSize.width / 2.0,
+                                 calibration.projectorSize.height / 2.0);
+    const double scale =
+        (core::applyHomography(h, centre + Eigen::Vector2d(1, 0)) - core::applyHomography(h, centre)).norm();
 
-    std::printf("lens %.1f mm (%.2f camera px per projector px), %s camera, gain %.2f, ambient %.0f DN, "
-                "albedo 0.25..0.9, neighbourhood %d, max error probability %.2f, min amplitude %.1f sigma, mixture "
-                "margin %.2f\n\n",
-                lensMm, scale, gray ? "gray" : "colour", scene.gain, scene.ambientDn, binarization.neighbourhood,
-                binarization.maxErrorProbability, binarization.minAmplitudeSigmas, binarization.mixtureMargin);
-    std::printf("| delta | noise sigma DN | BER known bits | unknown bits | window mismatches / known, table | "
-                "mismatches at 10 mm |\n| --- | --- | --- | --- | --- | --- |\n");
+    std::printf(
+        "lens %.1f mm (%.2f camera px per projector px), %s camera, gain %.2f, ambient %.0f DN, "
+        "albedo 0.25..0.9, neighbourhood %d, max error probability %.2f, min amplitude %.1f sigma, mixture "
+        "margin %.2f\n\n",
+        lensMm, scale, gray ? "gray" : "colour", scene.gain, scene.ambientDn, binarization.neighbourhood,
+        binarization.maxErrorProbability, binarization.minAmplitudeSigmas, binarization.mixtureMargin);
+    std::printf(
+        "| delta | noise sigma DN | BER known bits | unknown bits | window mismatches / known, table | "
+        "mismatches at 10 mm |\n| --- | --- | --- | --- | --- | --- |\n");
     for (int delta : {4, 6, 10, 16})
         for (double sigma : {0.0, 1.0, 2.0, 4.0}) {
             scene.delta = delta;

@@ -21,7 +21,8 @@ CodeIndex::CodeIndex(const cv::Mat& pattern, int window)
         const int row = static_cast<int>(i / static_cast<std::size_t>(anchors.width));
         entries_.push_back({codes[i], {anchors.x + column, anchors.y + row}});
     }
-    std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) { return a.code < b.code; });
+    std::sort(entries_.begin(), entries_.end(),
+              [](const Entry& a, const Entry& b) { return a.code < b.code; });
 
     const std::size_t values = std::size_t{1} << chunkBits_;
     for (int chunk = 0; chunk < kChunks; ++chunk) {
@@ -47,8 +48,9 @@ std::uint64_t CodeIndex::chunkOf(int chunk, std::uint64_t code) const {
 }
 
 std::optional<cv::Point> CodeIndex::find(std::uint64_t code) const {
-    const auto it = std::lower_bound(entries_.begin(), entries_.end(), code,
-                                     [](const Entry& entry, std::uint64_t value) { return entry.code < value; });
+    const auto it =
+        std::lower_bound(entries_.begin(), entries_.end(), code,
+                         [](const Entry& entry, std::uint64_t value) { return entry.code < value; });
     if (it == entries_.end() || it->code != code)
         return std::nullopt;
     return it->position;

@@ -42,7 +42,8 @@ public:
 
 private:
     static constexpr int kChunks = 4;
-    // Unknown bits of a chunk are tried both ways, up to this many (16 variants); chunks with more are skipped.
+    // Unknown bits of a chunk are tried both ways, up to this many (16 variants); chunks with more are
+    // skipped.
     static constexpr int kMaxUnknownPerChunk = 4;
 
     struct Entry {
@@ -54,7 +55,7 @@ private:
 
     int window_;
     int chunkBits_;
-    std::uint64_t codeMask_;  // the window*window bits a codeword has
+    std::uint64_t codeMask_;      // the window*window bits a codeword has
     std::vector<Entry> entries_;  // sorted by code
     // Per chunk, entries_ indices grouped by the chunk's value: those with value v are
     // chunkEntries_[c][chunkStart_[c][v]] .. chunkEntries_[c][chunkStart_[c][v + 1] - 1].

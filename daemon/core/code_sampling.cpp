@@ -47,8 +47,8 @@ CodeSample sampleCodeAtCamera(const cv::Mat& codeImage, const Eigen::Matrix3d& c
     return sample;
 }
 
-void matchAllWindows(const cv::Mat& codeImage, const Eigen::Matrix3d& projectorToCamera, const cv::Mat& pattern,
-                     int window, WindowAgreement& agreement) {
+void matchAllWindows(const cv::Mat& codeImage, const Eigen::Matrix3d& projectorToCamera,
+                     const cv::Mat& pattern, int window, WindowAgreement& agreement) {
     CV_Assert(codeImage.type() == CV_8UC1 && pattern.type() == CV_8UC1 && window >= 1 && window <= 8);
     cv::Matx33d homography;
     for (int r = 0; r < 3; ++r)
@@ -56,7 +56,8 @@ void matchAllWindows(const cv::Mat& codeImage, const Eigen::Matrix3d& projectorT
             homography(r, c) = projectorToCamera(r, c);
     // With WARP_INVERSE_MAP the matrix maps each output (projector) pixel to where it is read in the camera.
     cv::warpPerspective(codeImage, agreement.observed, homography, pattern.size(),
-                        cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(kUnknownBit));
+                        cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                        cv::Scalar(kUnknownBit));
 
     agreement.mismatchFlags.create(pattern.size(), CV_8UC1);
     agreement.knownFlags.create(pattern.size(), CV_8UC1);
@@ -75,7 +76,8 @@ void matchAllWindows(const cv::Mat& codeImage, const Eigen::Matrix3d& projectorT
     const cv::Point bottomRight(window - 1, window - 1);
     cv::boxFilter(agreement.mismatchFlags, agreement.mismatches, CV_8U, kernel, bottomRight, false,
                   cv::BORDER_CONSTANT);
-    cv::boxFilter(agreement.knownFlags, agreement.known, CV_8U, kernel, bottomRight, false, cv::BORDER_CONSTANT);
+    cv::boxFilter(agreement.knownFlags, agreement.known, CV_8U, kernel, bottomRight, false,
+                  cv::BORDER_CONSTANT);
 }
 
 }  // namespace everytouch::core

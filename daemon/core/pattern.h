@@ -11,12 +11,12 @@
 namespace everytouch::core {
 
 // The binary code pattern of paper Section V.B. Every projector pixel p with a full window is labelled by the
-// window x window block of pattern bits that has p as its bottom-right pixel (the window's "anchor"). Bit i of
-// the codeword is the pattern bit at row i / window, column i % window of the block, counted from its top-left
-// corner, so bit window*window - 1 is the anchor itself (paper eq. 16).
+// window x window block of pattern bits that has p as its bottom-right pixel (the window's "anchor"). Bit i
+// of the codeword is the pattern bit at row i / window, column i % window of the block, counted from its
+// top-left corner, so bit window*window - 1 is the anchor itself (paper eq. 16).
 //
-// The paper draws random patterns and keeps the best of 100 by mean distance, which guarantees nothing. Here a
-// repair pass then flips single bits until every codeword is unique and windows that are not spatial
+// The paper draws random patterns and keeps the best of 100 by mean distance, which guarantees nothing. Here
+// a repair pass then flips single bits until every codeword is unique and windows that are not spatial
 // neighbours differ in at least `minDistance` bits, so that that many bit errors are needed to mistake one
 // place on the panel for another.
 struct PatternOptions {
@@ -32,9 +32,9 @@ struct PatternOptions {
     // (never identical): mistaking one for the other misplaces a code by that many projector pixels, which is
     // within what the camera-projector homography resolves anyway.
     int neighbourRadius = 1;
-    // Upper bound on the bit flips the repair pass tries, per window of the pattern. Bounds the generation time
-    // when minDistance is out of reach; the pass stops earlier once the target holds (typically after a few
-    // thousandths of this at the defaults).
+    // Upper bound on the bit flips the repair pass tries, per window of the pattern. Bounds the generation
+    // time when minDistance is out of reach; the pass stops earlier once the target holds (typically after a
+    // few thousandths of this at the defaults).
     double repairTrialsPerWindow = 0.5;
 
     // The first problem found, naming the field; nothing when the options are usable.
