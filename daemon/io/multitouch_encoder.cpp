@@ -10,8 +10,8 @@ namespace everytouch::io {
 namespace {
 
 // BTN_TOOL_* for one, two, three, four and five or more fingers.
-constexpr std::array<std::uint16_t, 5> kFingerCountKeys = {BTN_TOOL_FINGER, BTN_TOOL_DOUBLETAP, BTN_TOOL_TRIPLETAP,
-                                                           BTN_TOOL_QUADTAP, BTN_TOOL_QUINTTAP};
+constexpr std::array<std::uint16_t, 5> kFingerCountKeys = {
+    BTN_TOOL_FINGER, BTN_TOOL_DOUBLETAP, BTN_TOOL_TRIPLETAP, BTN_TOOL_QUADTAP, BTN_TOOL_QUINTTAP};
 
 bool byId(const core::Contact* a, const core::Contact* b) {
     return a->id < b->id;
@@ -25,7 +25,8 @@ MultitouchEncoder::MultitouchEncoder(const TouchscreenAxes& axes) : axes_(axes) 
 }
 
 int MultitouchEncoder::activeSlots() const {
-    return static_cast<int>(std::count_if(slots_.begin(), slots_.end(), [](const Slot& s) { return s.held(); }));
+    return static_cast<int>(
+        std::count_if(slots_.begin(), slots_.end(), [](const Slot& s) { return s.held(); }));
 }
 
 void MultitouchEncoder::collectTouches(const core::Contacts& contacts) {
@@ -128,7 +129,8 @@ void MultitouchEncoder::emit(std::uint16_t type, std::uint16_t code, std::int32_
     events_.push_back({type, code, value});
 }
 
-void MultitouchEncoder::emitSlotValue(int slot, std::uint16_t code, std::int32_t value, std::int32_t& current) {
+void MultitouchEncoder::emitSlotValue(int slot, std::uint16_t code, std::int32_t value,
+                                      std::int32_t& current) {
     if (value == current)
         return;
     if (slot != currentSlot_) {

@@ -41,7 +41,8 @@ TouchscreenAxes TouchscreenAxes::forDisplay(cv::Size displaySize, cv::Size2d dis
     axes.unitsPerPixel = static_cast<int>(unitsPerPixel);
     axes.maximumX = displaySize.width * axes.unitsPerPixel - 1;
     axes.maximumY = displaySize.height * axes.unitsPerPixel - 1;
-    axes.resolutionX = static_cast<int>(std::lround(displaySize.width * axes.unitsPerPixel / displaySizeMm.width));
+    axes.resolutionX =
+        static_cast<int>(std::lround(displaySize.width * axes.unitsPerPixel / displaySizeMm.width));
     axes.resolutionY =
         static_cast<int>(std::lround(displaySize.height * axes.unitsPerPixel / displaySizeMm.height));
     return axes;

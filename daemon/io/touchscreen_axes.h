@@ -4,10 +4,11 @@
 
 namespace everytouch::io {
 
-// The absolute axes of the virtual touchscreen. A unit is a fixed fraction of a display pixel, fine enough that
-// the whole number of units per millimetre evdev carries as the axis resolution is within 0.5 % of the true
-// scale even on a large table lit by few pixels; libinput then reports the projected image's real size and
-// positions in millimetres. Positions map linearly, as every compositor maps a touchscreen onto its output.
+// The absolute axes of the virtual touchscreen. A unit is a fixed fraction of a display pixel, fine enough
+// that the whole number of units per millimetre evdev carries as the axis resolution is within 0.5 % of the
+// true scale even on a large table lit by few pixels; libinput then reports the projected image's real size
+// and positions in millimetres. Positions map linearly, as every compositor maps a touchscreen onto its
+// output.
 struct TouchscreenAxes {
     int unitsPerPixel = 1;  // axis units per display pixel, the same on both axes
     int maximumX = 0;       // largest x, units; the minimum is 0

@@ -29,7 +29,8 @@ input_absinfo axis(int maximum, int resolution) {
 }  // namespace
 
 UinputSink::UinputSink(const core::Calibration& calibration) {
-    const TouchscreenAxes axes = TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
+    const TouchscreenAxes axes =
+        TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
     adopt(createDevice(axes), axes);
 }
 
@@ -70,9 +71,10 @@ UniqueLibevdevUinput UinputSink::createDevice(const TouchscreenAxes& axes) {
     libevdev_uinput* created = nullptr;
     const int result = libevdev_uinput_create_from_device(d, LIBEVDEV_UINPUT_OPEN_MANAGED, &created);
     if (result < 0)
-        throw std::system_error(-result, std::generic_category(),
-                                "Failed to create the virtual touchscreen through /dev/uinput (needs the uinput "
-                                "kernel module and write access to /dev/uinput)");
+        throw std::system_error(
+            -result, std::generic_category(),
+            "Failed to create the virtual touchscreen through /dev/uinput (needs the uinput "
+            "kernel module and write access to /dev/uinput)");
     UniqueLibevdevUinput device(created);
     if (!libevdev_uinput_get_devnode(device.get()))
         throw std::runtime_error("The virtual touchscreen was created without an event node in /dev/input");
@@ -94,7 +96,8 @@ void UinputSink::publish(std::uint64_t, std::int64_t timestampUs, const core::Co
 }
 
 bool UinputSink::applyCalibration(const core::Calibration& calibration) {
-    const TouchscreenAxes axes = TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
+    const TouchscreenAxes axes =
+        TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
     if (axes == encoder_->axes())
         return false;
     releaseAll();

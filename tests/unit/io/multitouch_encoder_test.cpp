@@ -47,10 +47,10 @@ std::vector<std::string> named(const std::vector<EvdevEvent>& events) {
 TEST(MultitouchEncoder, FirstTouchSendsOnlyWhatDiffersFromTheFreshDevice) {
     MultitouchEncoder encoder(testAxes());
     // Slot 0 is current and its tool type is already MT_TOOL_FINGER on a new device.
-    EXPECT_THAT(named(encoder.encode(1000, {finger(7, 10, 20)})),
-                ElementsAre("ABS_MT_TRACKING_ID 0", "ABS_MT_POSITION_X 500", "ABS_MT_POSITION_Y 1000",
-                            "BTN_TOUCH 1", "BTN_TOOL_FINGER 1", "ABS_X 500", "ABS_Y 1000", "MSC_TIMESTAMP 1000",
-                            "SYN_REPORT 0"));
+    EXPECT_THAT(
+        named(encoder.encode(1000, {finger(7, 10, 20)})),
+        ElementsAre("ABS_MT_TRACKING_ID 0", "ABS_MT_POSITION_X 500", "ABS_MT_POSITION_Y 1000", "BTN_TOUCH 1",
+                    "BTN_TOOL_FINGER 1", "ABS_X 500", "ABS_Y 1000", "MSC_TIMESTAMP 1000", "SYN_REPORT 0"));
     EXPECT_EQ(encoder.activeSlots(), 1);
 }
 
@@ -79,16 +79,17 @@ TEST(MultitouchEncoder, ASecondFingerTakesTheNextSlotAndTheCountKey) {
                             "MSC_TIMESTAMP 8333", "SYN_REPORT 0"));
     // Both move: slot 0 must be selected again.
     EXPECT_THAT(named(encoder.encode(16666, {finger(7, 11, 20), finger(9, 31, 40)})),
-                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_POSITION_X 550", "ABS_MT_SLOT 1", "ABS_MT_POSITION_X 1550",
-                            "ABS_X 550", "MSC_TIMESTAMP 16666", "SYN_REPORT 0"));
+                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_POSITION_X 550", "ABS_MT_SLOT 1",
+                            "ABS_MT_POSITION_X 1550", "ABS_X 550", "MSC_TIMESTAMP 16666", "SYN_REPORT 0"));
 }
 
 TEST(MultitouchEncoder, AVanishedContactIsReleasedInTheNextFrame) {
     MultitouchEncoder encoder(testAxes());
     encoder.encode(0, {finger(7, 10, 20), finger(9, 30, 40)});
-    EXPECT_THAT(named(encoder.encode(8333, {finger(9, 30, 40)})),
-                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "BTN_TOOL_DOUBLETAP 0", "BTN_TOOL_FINGER 1", "ABS_X 1500",
-                            "ABS_Y 2000", "MSC_TIMESTAMP 8333", "SYN_REPORT 0"));
+    EXPECT_THAT(
+        named(encoder.encode(8333, {finger(9, 30, 40)})),
+        ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "BTN_TOOL_DOUBLETAP 0", "BTN_TOOL_FINGER 1",
+                    "ABS_X 1500", "ABS_Y 2000", "MSC_TIMESTAMP 8333", "SYN_REPORT 0"));
     EXPECT_EQ(encoder.activeSlots(), 1);
 }
 
@@ -96,9 +97,9 @@ TEST(MultitouchEncoder, AnEmptySetReleasesEverything) {
     MultitouchEncoder encoder(testAxes());
     encoder.encode(0, {finger(7, 10, 20), finger(9, 30, 40), palm(2, 90, 90)});
     EXPECT_THAT(named(encoder.encode(8333, {})),
-                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "ABS_MT_SLOT 1", "ABS_MT_TRACKING_ID -1",
-                            "ABS_MT_SLOT 2", "ABS_MT_TRACKING_ID -1", "BTN_TOUCH 0", "BTN_TOOL_DOUBLETAP 0",
-                            "MSC_TIMESTAMP 8333", "SYN_REPORT 0"));
+                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "ABS_MT_SLOT 1",
+                            "ABS_MT_TRACKING_ID -1", "ABS_MT_SLOT 2", "ABS_MT_TRACKING_ID -1", "BTN_TOUCH 0",
+                            "BTN_TOOL_DOUBLETAP 0", "MSC_TIMESTAMP 8333", "SYN_REPORT 0"));
     EXPECT_EQ(encoder.activeSlots(), 0);
 }
 
@@ -120,8 +121,8 @@ TEST(MultitouchEncoder, ANewTouchInAUsedSlotSendsOnlyValuesThatDiffer) {
     encoder.encode(1, {});
     // The kernel kept x = 500 in slot 0 and would drop an unchanged value.
     EXPECT_THAT(named(encoder.encode(2, {finger(2, 10, 30)})),
-                ElementsAre("ABS_MT_TRACKING_ID 1", "ABS_MT_POSITION_Y 1500", "BTN_TOUCH 1", "BTN_TOOL_FINGER 1",
-                            "ABS_Y 1500", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
+                ElementsAre("ABS_MT_TRACKING_ID 1", "ABS_MT_POSITION_Y 1500", "BTN_TOUCH 1",
+                            "BTN_TOOL_FINGER 1", "ABS_Y 1500", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
 }
 
 TEST(MultitouchEncoder, HoveringFingersAreNotTouches) {
@@ -144,7 +145,8 @@ TEST(MultitouchEncoder, AFingerTurningIntoAPalmKeepsItsSlotAndStopsCounting) {
                 ElementsAre("ABS_MT_TOOL_TYPE 2", "BTN_TOUCH 0", "BTN_TOOL_FINGER 0", "MSC_TIMESTAMP 1",
                             "SYN_REPORT 0"));
     EXPECT_EQ(encoder.activeSlots(), 1);
-    EXPECT_THAT(named(encoder.encode(2, {})), ElementsAre("ABS_MT_TRACKING_ID -1", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
+    EXPECT_THAT(named(encoder.encode(2, {})),
+                ElementsAre("ABS_MT_TRACKING_ID -1", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
     // The slot keeps MT_TOOL_PALM: the next finger there must set it back.
     EXPECT_THAT(named(encoder.encode(3, {finger(5, 10, 10)})),
                 ElementsAre("ABS_MT_TRACKING_ID 1", "ABS_MT_TOOL_TYPE 0", "BTN_TOUCH 1", "BTN_TOOL_FINGER 1",
@@ -162,16 +164,18 @@ TEST(MultitouchEncoder, TheSingleTouchAxesFollowTheOldestFinger) {
     MultitouchEncoder encoder(testAxes());
     encoder.encode(0, {finger(9, 10, 10)});
     encoder.encode(1, {finger(9, 10, 10), finger(2, 20, 20)});
-    EXPECT_THAT(named(encoder.encode(2, {finger(2, 20, 20)})),
-                ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "BTN_TOOL_DOUBLETAP 0", "BTN_TOOL_FINGER 1", "ABS_X 1000",
-                            "ABS_Y 1000", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
+    EXPECT_THAT(
+        named(encoder.encode(2, {finger(2, 20, 20)})),
+        ElementsAre("ABS_MT_SLOT 0", "ABS_MT_TRACKING_ID -1", "BTN_TOOL_DOUBLETAP 0", "BTN_TOOL_FINGER 1",
+                    "ABS_X 1000", "ABS_Y 1000", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
 }
 
 TEST(MultitouchEncoder, CountKeysGoUpToFiveOrMore) {
     MultitouchEncoder encoder(testAxes());
     core::Contacts contacts;
-    const std::vector<std::string> expectedKey = {"BTN_TOOL_FINGER 1", "BTN_TOOL_DOUBLETAP 1", "BTN_TOOL_TRIPLETAP 1",
-                                                  "BTN_TOOL_QUADTAP 1", "BTN_TOOL_QUINTTAP 1"};
+    const std::vector<std::string> expectedKey = {"BTN_TOOL_FINGER 1", "BTN_TOOL_DOUBLETAP 1",
+                                                  "BTN_TOOL_TRIPLETAP 1", "BTN_TOOL_QUADTAP 1",
+                                                  "BTN_TOOL_QUINTTAP 1"};
     for (std::uint32_t id = 0; id < 7; ++id) {
         contacts.push_back(finger(id, 10.0 * id, 10));
         const std::vector<std::string> names = named(encoder.encode(id, contacts));
@@ -213,8 +217,8 @@ TEST(MultitouchEncoder, ContactsWithoutAFinitePositionAreNotReported) {
 TEST(MultitouchEncoder, PositionsAreClampedToTheScreen) {
     MultitouchEncoder encoder(testAxes());
     EXPECT_THAT(named(encoder.encode(0, {finger(3, -5, 900)})),
-                ElementsAre("ABS_MT_TRACKING_ID 0", "ABS_MT_POSITION_Y 24999", "BTN_TOUCH 1", "BTN_TOOL_FINGER 1",
-                            "ABS_Y 24999", "MSC_TIMESTAMP 0", "SYN_REPORT 0"));
+                ElementsAre("ABS_MT_TRACKING_ID 0", "ABS_MT_POSITION_Y 24999", "BTN_TOUCH 1",
+                            "BTN_TOOL_FINGER 1", "ABS_Y 24999", "MSC_TIMESTAMP 0", "SYN_REPORT 0"));
 }
 
 TEST(MultitouchEncoder, TimestampsWrapAtThirtyTwoBits) {
@@ -284,7 +288,8 @@ TEST(MultitouchEncoder, AReaderOfTheEventsSeesTheTouchingContactsAfterEveryRepor
                 case ABS_MT_TRACKING_ID:
                     ASSERT_NE(e.value, slot.trackingId) << "an unchanged value was sent";
                     ASSERT_TRUE(e.value == -1 || slot.trackingId == -1) << "a held slot changed hands";
-                    ASSERT_TRUE(e.value == -1 || trackingIdsSeen.insert(e.value).second) << "tracking id reused";
+                    ASSERT_TRUE(e.value == -1 || trackingIdsSeen.insert(e.value).second)
+                        << "tracking id reused";
                     slot.trackingId = e.value;
                     released += e.value == -1;
                     break;

@@ -18,7 +18,8 @@ void expectSizeWithin(const TouchscreenAxes& axes, cv::Size2d expectedMm, double
 
 TEST(TouchscreenAxes, ReportTheProjectedSizeOfThePaperRigWithinHalfAPercent) {
     const core::Calibration calibration = test::paperLikeCalibration();
-    const TouchscreenAxes axes = TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
+    const TouchscreenAxes axes =
+        TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
     expectSizeWithin(axes, calibration.displaySizeMm(), 0.005);
     EXPECT_EQ(axes.maximumX + 1, calibration.displaySize.width * axes.unitsPerPixel);
     EXPECT_EQ(axes.maximumY + 1, calibration.displaySize.height * axes.unitsPerPixel);
