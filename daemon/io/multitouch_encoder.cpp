@@ -90,12 +90,16 @@ void MultitouchEncoder::moveSlotsTo(const std::array<Slot, kSlotCount>& target) 
     for (int i = 0; i < kSlotCount; ++i) {
         Slot& slot = slots_[i];
         const Slot& wanted = target[i];
-        emitSlotValue(i, ABS_MT_TRACKING_ID, wanted.trackingId, slot.trackingId);
-        if (!wanted.held())
+        if (!wanted.held()) {
+            emitSlotValue(i, ABS_MT_TRACKING_ID, -1, slot.trackingId);
             continue;
+        }
+        // The tool type goes first: libinput classifies a new touch by the slot's tool type at the moment the
+        // tracking id arrives, so a finger landing where a palm was would otherwise stay a palm.
+        emitSlotValue(i, ABS_MT_TOOL_TYPE, wanted.toolType, slot.toolType);
+        emitSlotValue(i, ABS_MT_TRACKING_ID, wanted.trackingId, slot.trackingId);
         slot.contactId = wanted.contactId;
         slot.touchOrder = wanted.touchOrder;
-        emitSlotValue(i, ABS_MT_TOOL_TYPE, wanted.toolType, slot.toolType);
         emitSlotValue(i, ABS_MT_POSITION_X, wanted.x, slot.x);
         emitSlotValue(i, ABS_MT_POSITION_Y, wanted.y, slot.y);
     }

@@ -33,8 +33,9 @@ struct EvdevEvent {
 //   counts. A contact with a non-finite position is not reported.
 // - Every touch gets a tracking id never used before on the device (until 2^31 touches wrap it around).
 // - A palm keeps its slot with tool type MT_TOOL_PALM: libinput cancels a touch that turns into a palm and
-//   ignores one that starts as a palm. Palms do not count as fingers: BTN_TOUCH, BTN_TOOL_FINGER ...
-//   BTN_TOOL_QUINTTAP (five or more) and the single-touch ABS_X/ABS_Y (the oldest finger) follow fingers.
+//   ignores one that starts as a palm. A new touch sets the slot's tool type before its tracking id. Palms do
+//   not count as fingers: BTN_TOUCH, BTN_TOOL_FINGER ... BTN_TOOL_QUINTTAP (five or more) and the
+//   single-touch ABS_X/ABS_Y (the oldest finger) follow fingers.
 // - Each frame that changes anything ends with MSC_TIMESTAMP (microseconds, wrapping at 32 bits) and one
 //   SYN_REPORT.
 class MultitouchEncoder {

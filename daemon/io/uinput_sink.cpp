@@ -2,15 +2,21 @@
 
 #include <linux/input.h>
 
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <system_error>
+#include <thread>
 
 #include "io/log.h"
 
 namespace everytouch::io {
 
 namespace {
+
+// Readers lose what they have not read when a device goes away; a few frames of any compositor let them read
+// the lift first. (libinput lifts the touches of a vanished device itself, other readers may not.)
+constexpr std::chrono::milliseconds kLiftDeliveryTime{50};
 
 void enable(libevdev* description, unsigned type, unsigned code, const input_absinfo* absinfo = nullptr) {
     if (libevdev_enable_event_code(description, type, code, absinfo) != 0)
@@ -107,7 +113,11 @@ bool UinputSink::applyCalibration(const core::Calibration& calibration) {
 }
 
 void UinputSink::releaseAll() {
-    write(encoder_->encode(lastTimestampUs_, {}));
+    const std::vector<EvdevEvent>& events = encoder_->encode(lastTimestampUs_, {});
+    if (events.empty())
+        return;
+    write(events);
+    std::this_thread::sleep_for(kLiftDeliveryTime);
 }
 
 void UinputSink::write(const std::vector<EvdevEvent>& events) {

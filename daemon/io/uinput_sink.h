@@ -44,6 +44,7 @@ public:
 private:
     static UniqueLibevdevUinput createDevice(const TouchscreenAxes& axes);
     void adopt(UniqueLibevdevUinput device, const TouchscreenAxes& axes);
+    // Lifts every contact; when any was down, waits for readers to take the lift before the device may go.
     void releaseAll();
     void write(const std::vector<EvdevEvent>& events);
 

@@ -149,14 +149,14 @@ TEST(MultitouchEncoder, AFingerTurningIntoAPalmKeepsItsSlotAndStopsCounting) {
                 ElementsAre("ABS_MT_TRACKING_ID -1", "MSC_TIMESTAMP 2", "SYN_REPORT 0"));
     // The slot keeps MT_TOOL_PALM: the next finger there must set it back.
     EXPECT_THAT(named(encoder.encode(3, {finger(5, 10, 10)})),
-                ElementsAre("ABS_MT_TRACKING_ID 1", "ABS_MT_TOOL_TYPE 0", "BTN_TOUCH 1", "BTN_TOOL_FINGER 1",
+                ElementsAre("ABS_MT_TOOL_TYPE 0", "ABS_MT_TRACKING_ID 1", "BTN_TOUCH 1", "BTN_TOOL_FINGER 1",
                             "MSC_TIMESTAMP 3", "SYN_REPORT 0"));
 }
 
 TEST(MultitouchEncoder, APalmFromTheStartIsNoFinger) {
     MultitouchEncoder encoder(testAxes());
     EXPECT_THAT(named(encoder.encode(0, {palm(4, 10, 10)})),
-                ElementsAre("ABS_MT_TRACKING_ID 0", "ABS_MT_TOOL_TYPE 2", "ABS_MT_POSITION_X 500",
+                ElementsAre("ABS_MT_TOOL_TYPE 2", "ABS_MT_TRACKING_ID 0", "ABS_MT_POSITION_X 500",
                             "ABS_MT_POSITION_Y 500", "MSC_TIMESTAMP 0", "SYN_REPORT 0"));
 }
 
