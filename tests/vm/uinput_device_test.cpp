@@ -34,14 +34,17 @@ using ::testing::Not;
 // Under emulation a client can take seconds to start; nothing here waits that long when things work.
 constexpr auto kPatience = 30s;
 
-#define SKIP_WITHOUT_UINPUT()                                                                                    \
-    do {                                                                                                         \
-        if (!std::filesystem::exists("/dev/uinput"))                                                             \
-            GTEST_SKIP() << "/dev/uinput is missing (no uinput kernel module here); tests/vm runs these tests "  \
-                            "on a real kernel";                                                                  \
-        if (const char* allowed = std::getenv("EVERYTOUCH_UINPUT_TESTS"); !allowed || std::string(allowed) != "1") \
-            GTEST_SKIP() << "these tests create a touchscreen a running desktop would act on; tests/vm sets "    \
-                            "EVERYTOUCH_UINPUT_TESTS=1 to run them";                                             \
+#define SKIP_WITHOUT_UINPUT()                                                                          \
+    do {                                                                                               \
+        if (!std::filesystem::exists("/dev/uinput"))                                                   \
+            GTEST_SKIP()                                                                               \
+                << "/dev/uinput is missing (no uinput kernel module here); tests/vm runs these tests " \
+                   "on a real kernel";                                                                 \
+        if (const char* allowed = std::getenv("EVERYTOUCH_UINPUT_TESTS");                              \
+            !allowed || std::string(allowed) != "1")                                                   \
+            GTEST_SKIP()                                                                               \
+                << "these tests create a touchscreen a running desktop would act on; tests/vm sets "   \
+                   "EVERYTOUCH_UINPUT_TESTS=1 to run them";                                            \
     } while (false)
 
 std::string readFile(const std::filesystem::path& path) {
@@ -67,7 +70,8 @@ std::filesystem::path udevDatabaseEntry(const std::string& devnode) {
     struct stat info {};
     if (stat(devnode.c_str(), &info) != 0)
         return {};
-    return "/run/udev/data/c" + std::to_string(major(info.st_rdev)) + ":" + std::to_string(minor(info.st_rdev));
+    return "/run/udev/data/c" + std::to_string(major(info.st_rdev)) + ":" +
+           std::to_string(minor(info.st_rdev));
 }
 
 // Waits until udev has processed the device; libinput ignores input devices udev has not tagged.
@@ -160,14 +164,16 @@ std::vector<io::EvdevEvent> evemuEvents(const std::string& output) {
 std::string describe(const std::vector<io::EvdevEvent>& events) {
     std::string text;
     for (const io::EvdevEvent& e : events)
-        text += std::string(libevdev_event_code_get_name(e.type, e.code)) + " " + std::to_string(e.value) + "\n";
+        text +=
+            std::string(libevdev_event_code_get_name(e.type, e.code)) + " " + std::to_string(e.value) + "\n";
     return text;
 }
 
 // Reads a device node through libevdev, as a compositor would, without blocking.
 class EvdevReader {
 public:
-    explicit EvdevReader(const std::string& devnode) : fd_(open(devnode.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)) {
+    explicit EvdevReader(const std::string& devnode)
+        : fd_(open(devnode.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)) {
         libevdev* device = nullptr;
         if (fd_ && libevdev_new_from_fd(fd_.get(), &device) == 0)
             device_.reset(device);
@@ -209,7 +215,8 @@ protected:
         reader_ = std::make_unique<EvdevReader>(devnode_);
         ASSERT_TRUE(*reader_) << "libevdev cannot read " << devnode_;
         libinput_ = std::make_unique<test::BackgroundProcess>(
-            std::vector<std::string>{"libinput", "debug-events", "--device", devnode_}, dir_ / "libinput.txt");
+            std::vector<std::string>{"libinput", "debug-events", "--device", devnode_},
+            dir_ / "libinput.txt");
         evemu_ = std::make_unique<test::BackgroundProcess>(std::vector<std::string>{"evemu-record", devnode_},
                                                            dir_ / "evemu.txt");
         ASSERT_TRUE(attached(*libinput_, devnode_) && attached(*evemu_, devnode_))
@@ -254,7 +261,8 @@ protected:
     std::unique_ptr<EvdevReader> reader_;
     std::unique_ptr<test::BackgroundProcess> libinput_;
     std::unique_ptr<test::BackgroundProcess> evemu_;
-    io::MultitouchEncoder twin_{io::TouchscreenAxes::forDisplay(calibration_.displaySize, calibration_.displaySizeMm())};
+    io::MultitouchEncoder twin_{
+        io::TouchscreenAxes::forDisplay(calibration_.displaySize, calibration_.displaySizeMm())};
     std::uint64_t frame_ = 0;
     std::vector<io::EvdevEvent> expected_;  // everything sent, including the lift on removal
     std::vector<io::EvdevEvent> readable_;  // what was sent while the device existed
@@ -276,7 +284,8 @@ TEST_F(LiveTouchscreen, DescribesADirectTouchscreenOfTheProjectedSize) {
     EXPECT_TRUE(libevdev_has_property(device, INPUT_PROP_DIRECT));
     EXPECT_TRUE(libevdev_has_event_code(device, EV_KEY, BTN_TOUCH));
     for (unsigned absent : {BTN_LEFT, BTN_TOOL_PEN, BTN_STYLUS, BTN_TOOL_RUBBER})
-        EXPECT_FALSE(libevdev_has_event_code(device, EV_KEY, absent)) << libevdev_event_code_get_name(EV_KEY, absent);
+        EXPECT_FALSE(libevdev_has_event_code(device, EV_KEY, absent))
+            << libevdev_event_code_get_name(EV_KEY, absent);
     EXPECT_EQ(libevdev_get_num_slots(device), 10);
     EXPECT_TRUE(libevdev_has_event_code(device, EV_MSC, MSC_TIMESTAMP));
     const io::TouchscreenAxes& axes = sink_->axes();
@@ -289,6 +298,7 @@ TEST_F(LiveTouchscreen, DescribesADirectTouchscreenOfTheProjectedSize) {
         EXPECT_EQ(libevdev_get_abs_resolution(device, code), axes.resolutionY);
     }
 
+    std::cout << "udev database entry of " << devnode_ << ":\n" << udev_;
     EXPECT_THAT(udev_, HasSubstr("E:ID_INPUT_TOUCHSCREEN=1"));
     for (const char* other : {"ID_INPUT_TABLET", "ID_INPUT_TOUCHPAD", "ID_INPUT_MOUSE", "ID_INPUT_JOYSTICK"})
         EXPECT_THAT(udev_, Not(HasSubstr(other)));
@@ -310,22 +320,23 @@ TEST_F(LiveTouchscreen, DescribesADirectTouchscreenOfTheProjectedSize) {
 
 TEST_F(LiveTouchscreen, ClientsFollowAScriptedHand) {
     // Display pixels of the paper rig's 1280x960 display.
-    publish({finger(1, 320, 240)});                                 // down
-    for (int step = 1; step <= 4; ++step)                           // move right
+    publish({finger(1, 320, 240)});        // down
+    for (int step = 1; step <= 4; ++step)  // move right
         publish({finger(1, 320 + 20 * step, 240)});
-    publish({finger(1, 400, 240), finger(2, 960, 720)});            // a second finger
-    publish({finger(1, 410, 250), finger(2, 950, 710)});            // both move
-    publish({finger(1, 420, 260), {2, 950, 710, true, 0.0, true}});  // the second turns out a palm
-    publish({finger(1, 430, 270)});                                 // the palm vanishes
+    publish({finger(1, 400, 240), finger(2, 960, 720)});                // a second finger
+    publish({finger(1, 410, 250), finger(2, 950, 710)});                // both move
+    publish({finger(1, 420, 260), {2, 950, 710, true, 0.0, true}});     // the second turns out a palm
+    publish({finger(1, 430, 270)});                                     // the palm vanishes
     publish({finger(1, 430, 270), {3, 640, 480, false, 12.0, false}});  // a hovering finger is no touch
-    publish({finger(1, 430, 270), finger(3, 640, 480)});            // until it lands
-    publish({finger(3, 640, 480)});                                 // the first vanishes
-    publish({});                                                    // all lifted
+    publish({finger(1, 430, 270), finger(3, 640, 480)});                // until it lands
+    publish({finger(3, 640, 480)});                                     // the first vanishes
+    publish({});                                                        // all lifted
     finish();
 
     EXPECT_EQ(describe(read_), describe(readable_)) << "libevdev read other events than were encoded";
     EXPECT_EQ(describe(evemuEvents(evemuOutput_)), describe(expected_)) << evemuOutput_;
     EXPECT_THAT(evemuOutput_, HasSubstr("N: everytouch virtual touchscreen"));
+    std::cout << "evemu-record:\n" << evemuOutput_;
 
     struct Expected {
         const char* type;
@@ -333,11 +344,20 @@ TEST_F(LiveTouchscreen, ClientsFollowAScriptedHand) {
         double x = -1, y = -1;  // display pixels, for DOWN and MOTION
     };
     const std::vector<Expected> script = {
-        {"TOUCH_DOWN", 0, 320, 240},   {"TOUCH_MOTION", 0, 340, 240}, {"TOUCH_MOTION", 0, 360, 240},
-        {"TOUCH_MOTION", 0, 380, 240}, {"TOUCH_MOTION", 0, 400, 240}, {"TOUCH_DOWN", 1, 960, 720},
-        {"TOUCH_MOTION", 0, 410, 250}, {"TOUCH_MOTION", 1, 950, 710}, {"TOUCH_MOTION", 0, 420, 260},
-        {"TOUCH_CANCEL", 1},           {"TOUCH_MOTION", 0, 430, 270}, {"TOUCH_DOWN", 1, 640, 480},
-        {"TOUCH_UP", 0},               {"TOUCH_UP", 1},
+        {"TOUCH_DOWN", 0, 320, 240},
+        {"TOUCH_MOTION", 0, 340, 240},
+        {"TOUCH_MOTION", 0, 360, 240},
+        {"TOUCH_MOTION", 0, 380, 240},
+        {"TOUCH_MOTION", 0, 400, 240},
+        {"TOUCH_DOWN", 1, 960, 720},
+        {"TOUCH_MOTION", 0, 410, 250},
+        {"TOUCH_MOTION", 1, 950, 710},
+        {"TOUCH_MOTION", 0, 420, 260},
+        {"TOUCH_CANCEL", 1},
+        {"TOUCH_MOTION", 0, 430, 270},
+        {"TOUCH_DOWN", 1, 640, 480},
+        {"TOUCH_UP", 0},
+        {"TOUCH_UP", 1},
     };
     const std::vector<LibinputTouch> seen = libinputTouches(libinputOutput_);
     std::cout << "libinput debug-events:\n" << libinputOutput_;
@@ -361,7 +381,8 @@ TEST_F(LiveTouchscreen, RemovingTheDeviceLiftsEveryContactFirst) {
     publish({finger(4, 110, 100), finger(5, 1100, 810)});
     finish();
     EXPECT_EQ(describe(read_), describe(readable_));
-    EXPECT_EQ(describe(evemuEvents(evemuOutput_)), describe(expected_)) << "the lift did not reach evemu-record";
+    EXPECT_EQ(describe(evemuEvents(evemuOutput_)), describe(expected_))
+        << "the lift did not reach evemu-record";
     std::map<int, int> down;
     for (const LibinputTouch& touch : libinputTouches(libinputOutput_))
         down[touch.slot] = touch.type == "TOUCH_DOWN" || touch.type == "TOUCH_MOTION";
@@ -398,7 +419,8 @@ TEST(UinputSink, ANewDisplaySizeRecreatesTheDeviceAfterLiftingContacts) {
     ASSERT_THAT(udevProperties(sink.devnode()), HasSubstr("E:ID_INPUT_TOUCHSCREEN=1"));
     EvdevReader newReader(sink.devnode());
     ASSERT_TRUE(newReader);
-    EXPECT_EQ(libevdev_get_abs_maximum(newReader.get(), ABS_MT_POSITION_X), 1920 * sink.axes().unitsPerPixel - 1);
+    EXPECT_EQ(libevdev_get_abs_maximum(newReader.get(), ABS_MT_POSITION_X),
+              1920 * sink.axes().unitsPerPixel - 1);
     const cv::Size2d sizeMm = calibration.displaySizeMm();
     EXPECT_NEAR(sink.axes().sizeMm().width, sizeMm.width, 0.005 * sizeMm.width);
     const std::filesystem::path secondEntry = udevDatabaseEntry(sink.devnode());
@@ -450,7 +472,8 @@ TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
 
     daemon.signal(SIGTERM);
     EXPECT_EQ(daemon.wait(kPatience), 0) << readFile(dir / "daemon.log");
-    EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); })) << "the touchscreen outlived the daemon";
+    EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); }))
+        << "the touchscreen outlived the daemon";
     std::cout << "everytouchd log:\n" << readFile(dir / "daemon.log");
 }
 
