@@ -31,7 +31,8 @@ struct EvdevEvent {
 //   to another within a frame). With more than `kSlotCount` touches, new contacts are taken in ascending id
 //   order and the rest wait, unreported, until a slot is free. Of several contacts sharing an id, the first
 //   counts. A contact with a non-finite position is not reported.
-// - Every touch gets a tracking id never used before on the device (until 2^31 touches wrap it around).
+// - Every touch gets the next tracking id; they wrap after 65536 touches, so no id repeats within that many
+//   touches of the device.
 // - A palm keeps its slot with tool type MT_TOOL_PALM: libinput cancels a touch that turns into a palm and
 //   ignores one that starts as a palm. A new touch sets the slot's tool type before its tracking id. Palms do
 //   not count as fingers: BTN_TOUCH, BTN_TOOL_FINGER ... BTN_TOOL_QUINTTAP (five or more) and the
@@ -41,7 +42,8 @@ struct EvdevEvent {
 class MultitouchEncoder {
 public:
     static constexpr int kSlotCount = 10;
-    static constexpr std::int32_t kMaximumTrackingId = 0x7fffffff;
+    // The kernel gives every multitouch device tracking ids 0..65535, whatever the device asks for.
+    static constexpr std::int32_t kMaximumTrackingId = 0xffff;
 
     explicit MultitouchEncoder(const TouchscreenAxes& axes);
 

@@ -287,6 +287,8 @@ TEST_F(LiveTouchscreen, DescribesADirectTouchscreenOfTheProjectedSize) {
         EXPECT_FALSE(libevdev_has_event_code(device, EV_KEY, absent))
             << libevdev_event_code_get_name(EV_KEY, absent);
     EXPECT_EQ(libevdev_get_num_slots(device), 10);
+    EXPECT_EQ(libevdev_get_abs_maximum(device, ABS_MT_TRACKING_ID),
+              io::MultitouchEncoder::kMaximumTrackingId);
     EXPECT_TRUE(libevdev_has_event_code(device, EV_MSC, MSC_TIMESTAMP));
     const io::TouchscreenAxes& axes = sink_->axes();
     for (unsigned code : {ABS_X, ABS_MT_POSITION_X}) {

@@ -115,6 +115,19 @@ TEST(MultitouchEncoder, TrackingIdsAreNeverReused) {
     EXPECT_THAT(ids, ElementsAre(0, 1, 2, 3, 4));
 }
 
+TEST(MultitouchEncoder, TrackingIdsWrapAtTheKernelsRange) {
+    MultitouchEncoder encoder(testAxes());
+    std::int32_t last = -1;
+    for (int touch = 0; touch <= MultitouchEncoder::kMaximumTrackingId + 1; ++touch) {
+        for (const EvdevEvent& event : encoder.encode(touch * 2, {finger(1, 10, 10)}))
+            if (event.code == ABS_MT_TRACKING_ID)
+                last = event.value;
+        encoder.encode(touch * 2 + 1, {});
+        ASSERT_EQ(last, touch % (MultitouchEncoder::kMaximumTrackingId + 1));
+    }
+    EXPECT_EQ(last, 0);
+}
+
 TEST(MultitouchEncoder, ANewTouchInAUsedSlotSendsOnlyValuesThatDiffer) {
     MultitouchEncoder encoder(testAxes());
     encoder.encode(0, {finger(1, 10, 20)});
