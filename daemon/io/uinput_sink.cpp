@@ -14,8 +14,8 @@ namespace everytouch::io {
 
 namespace {
 
-// Readers lose what they have not read when a device goes away; a few frames of any compositor let them read
-// the lift first. (libinput lifts the touches of a vanished device itself, other readers may not.)
+// Readers lose what they have not read when a device goes away (the kernel answers ENODEV at once); a few
+// frames of any compositor let them read the lift first.
 constexpr std::chrono::milliseconds kLiftDeliveryTime{50};
 
 void enable(libevdev* description, unsigned type, unsigned code, const input_absinfo* absinfo = nullptr) {
