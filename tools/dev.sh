@@ -42,7 +42,7 @@ build() {
     cmake --build "$dir" -j "$jobs"
 }
 
-cpp_files() { git ls-files '*.cpp' '*.h' ; }
+cpp_files() { git ls-files --cached --others --exclude-standard '*.cpp' '*.h'; }
 
 command=${1:-}
 [ $# -gt 0 ] && shift
