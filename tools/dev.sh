@@ -14,6 +14,7 @@ packages=(
     libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools
     libcli11-dev nlohmann-json3-dev
     dbus systemd udev
+    qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils
 )
 
 jobs=$(nproc)
