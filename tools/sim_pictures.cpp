@@ -24,13 +24,6 @@ struct Shot {
     std::vector<std::pair<std::string, std::string>> options;
 };
 
-cv::Mat randomPattern(cv::Size size, std::uint64_t seed) {
-    cv::Mat pattern(size, CV_8UC1);
-    cv::RNG rng(seed);
-    rng.fill(pattern, cv::RNG::UNIFORM, 0, 2);
-    return pattern;
-}
-
 void save(const std::filesystem::path& path, const cv::Mat& image) {
     if (!cv::imwrite(path.string(), image))
         throw std::runtime_error("cannot write " + path.string());
@@ -59,7 +52,7 @@ int main(int argc, char** argv) {
             for (const auto& [key, value] : shot.options)
                 if (auto problem = sim::applyOption(parameters, key, value))
                     throw std::runtime_error(key + ": " + *problem);
-            sim::Simulator simulator(parameters, randomPattern(parameters.projectorSize, parameters.seed));
+            sim::Simulator simulator(parameters, sim::rigPattern(parameters));
             const auto index =
                 static_cast<std::uint64_t>(shot.seconds * parameters.frameRate) & ~std::uint64_t{1};
             core::Frame positive, negative;

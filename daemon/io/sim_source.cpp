@@ -11,18 +11,6 @@
 
 namespace everytouch::io {
 
-namespace {
-
-// The projected code: a random binary pattern of the projector's size, fixed by the seed.
-cv::Mat randomPattern(cv::Size size, std::uint64_t seed) {
-    cv::Mat pattern(size, CV_8UC1);
-    cv::RNG rng(seed);
-    rng.fill(pattern, cv::RNG::UNIFORM, 0, 2);
-    return pattern;
-}
-
-}  // namespace
-
 SimSource::SimSource(const RigSpec& spec, bool paced) : spec_(spec.toString()), paced_(paced) {
     const std::string input = "--rig " + spec_;
     sim::SimParameters parameters;
@@ -31,6 +19,8 @@ SimSource::SimSource(const RigSpec& spec, bool paced) : spec_(spec.toString()), 
     for (const auto& [key, value] : spec.options)
         if (auto problem = sim::applyOption(parameters, key, value))
             throw InputError(input, key, *problem);
+    if (auto problem = parameters.validate())
+        throw InputError(input, "", *problem);
     cv::Mat contentImage;
     if (parameters.content != "auto" && !sim::contentKindFromName(parameters.content)) {
         contentImage = cv::imread(parameters.content, cv::IMREAD_COLOR);
@@ -42,8 +32,7 @@ SimSource::SimSource(const RigSpec& spec, bool paced) : spec_(spec.toString()), 
                     "nor a readable image file");
     }
     try {
-        simulator_ = std::make_unique<sim::Simulator>(
-            parameters, randomPattern(parameters.projectorSize, parameters.seed), contentImage);
+        simulator_ = std::make_unique<sim::Simulator>(parameters, sim::rigPattern(parameters), contentImage);
     } catch (const std::invalid_argument& error) {
         throw InputError(input, "", error.what());
     }

@@ -103,16 +103,6 @@ cv::Mat toCv(const Eigen::Matrix3d& m) {
 
 }  // namespace
 
-struct Renderer::PreparedCapsule {
-    CapsuleHit camera;
-    CapsuleHit projector;
-    Eigen::Matrix3f cameraPixelToLocal;  // (u, v, 1) -> local direction
-    Eigen::Matrix3f projectorPixelToLocal;
-    cv::Rect cameraBox, projectorBox;
-    HandPart part;
-    float length;
-};
-
 Renderer::Renderer(const SimParameters& parameters, const core::Calibration& calibration,
                    const cv::Mat& pattern)
     : parameters_(parameters),
@@ -199,6 +189,7 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
 
     shadowDepth_ = cv::Mat(panelSize, CV_32FC1, cv::Scalar(kNoHit));
     shadowMask_ = cv::Mat::zeros(panelSize, CV_32FC1);
+    blockedOnTable_.create(cameraSize, CV_32FC1);
     depth_ = cv::Mat(cameraSize, CV_32FC1, cv::Scalar(kNoHit));
     hitIndex_ = cv::Mat(cameraSize, CV_16SC1, cv::Scalar(-1));
 }
@@ -352,16 +343,17 @@ void Renderer::shadeTable(const cv::Rect& box, const cv::Mat& projected) {
     Eigen::Matrix3d toPanel = Eigen::Matrix3d::Identity(), fromCamera = Eigen::Matrix3d::Identity();
     toPanel(0, 2) = -shadowBox_.x, toPanel(1, 2) = -shadowBox_.y;
     fromCamera(0, 2) = box.x, fromCamera(1, 2) = box.y;
-    cv::warpPerspective(shadowMask_(shadowBox_), blockedOnTable_,
-                        toCv(toPanel * cameraToProjector_ * fromCamera), box.size(),
-                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::Mat blocked = blockedOnTable_(box);
+    cv::warpPerspective(shadowMask_(shadowBox_), blocked, toCv(toPanel * cameraToProjector_ * fromCamera),
+                        box.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                        cv::Scalar(0));
     for (int y = 0; y < box.height; ++y) {
-        const float* blocked = blockedOnTable_.ptr<float>(y);
+        const float* fraction = blocked.ptr<float>(y);
         float* out = radiance_.ptr<float>(box.y + y) + 3 * box.x;
         const float* lit = projected.ptr<float>(box.y + y) + 3 * box.x;
         for (int x = 0; x < box.width; ++x)
             for (int c = 0; c < 3; ++c)
-                out[3 * x + c] -= blocked[x] * lit[3 * x + c];
+                out[3 * x + c] -= fraction[x] * lit[3 * x + c];
     }
 }
 
@@ -502,7 +494,8 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
     truth.ambientLux = ambientLux;
     truth.exposureMs = exposureMs;
 
-    std::vector<PreparedCapsule> capsules;
+    std::vector<PreparedCapsule>& capsules = capsules_;
+    capsules.clear();
     cv::Rect cameraBox, projectorBox;
     const Eigen::Matrix3f cameraPixelToRay = cameraPixelToRay_.cast<float>();
     const Eigen::Matrix3f projectorPixelToRay = projectorPixelToRay_.cast<float>();
@@ -571,14 +564,17 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
         const cv::Rect inputPart = cv::Rect(changed.x - 2 * reach, changed.y - 2 * reach,
                                             changed.width + 4 * reach, changed.height + 4 * reach) &
                                    image;
-        if (radiance_.empty())
+        if (radiance_.empty()) {
             radiance_ = cv::Mat::zeros(cameraSize, CV_32FC3);
+            partBlurred_.create(cameraSize, CV_32FC3);
+        }
         cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart),
                      radiance_(inputPart));
         shadeTable(shadowBox, projected_[polarityIndex]);
         castHands(capsules, cameraBox, polarityIndex, ambientLux, truth);
-        blurIfNeeded(radiance_(inputPart), partBlurred_, parameters_.cameraDefocusPx);
-        partBlurred_(blurredPart - inputPart.tl()).copyTo(frame(blurredPart));
+        cv::Mat blurred = partBlurred_(inputPart);
+        blurIfNeeded(radiance_(inputPart), blurred, parameters_.cameraDefocusPx);
+        partBlurred_(blurredPart).copyTo(frame(blurredPart));
         dirty = blurredPart;
     }
     sensor_.expose(frame, exposureMs, noiseSeed, image);

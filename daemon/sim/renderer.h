@@ -67,7 +67,16 @@ public:
     const CameraSensor& sensor() const { return sensor_; }
 
 private:
-    struct PreparedCapsule;
+    // A hand capsule ready for ray casting from both devices, with its image regions.
+    struct PreparedCapsule {
+        CapsuleHit camera;
+        CapsuleHit projector;
+        Eigen::Matrix3f cameraPixelToLocal;  // (u, v, 1) -> local ray direction
+        Eigen::Matrix3f projectorPixelToLocal;
+        cv::Rect cameraBox, projectorBox;
+        HandPart part;
+        float length;
+    };
 
     void castShadows(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box);
     // Camera region of the table that hand shadows within `projectorBox` can fall on.
@@ -119,9 +128,10 @@ private:
     int frameContentVersion_[2] = {-1, -1};
     int contentVersion_ = 0;
     int lastPolarity_ = 0;
-    cv::Mat partBlurred_;
-    cv::Mat blockedOnTable_;  // CV_32FC1: shadow mask in camera pixels of the shadow's region
-    cv::Mat work_[4];         // content precomputation
+    cv::Mat partBlurred_;     // CV_32FC3, camera size: the changed region through the camera's blur
+    cv::Mat blockedOnTable_;  // CV_32FC1, camera size: shadow mask in camera pixels, in the shadow's region
+    std::vector<PreparedCapsule> capsules_;
+    cv::Mat work_[4];  // content precomputation
 };
 
 }  // namespace everytouch::sim

@@ -5,6 +5,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/pattern.h"
 #include "sim/rig_geometry.h"
 
 namespace everytouch::sim {
@@ -19,6 +20,13 @@ std::uint64_t mix(std::uint64_t value) {
 }
 
 }  // namespace
+
+cv::Mat rigPattern(const SimParameters& parameters) {
+    core::PatternOptions options;
+    options.size = parameters.projectorSize;
+    options.seed = parameters.seed;
+    return core::generatePattern(options);
+}
 
 Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, const cv::Mat& contentImage)
     : parameters_(parameters) {

@@ -14,15 +14,19 @@
 
 namespace everytouch::sim {
 
+// The code the simulated rig projects: the project's pattern (core::generatePattern) for the projector's
+// size, 6x6 windows, from the parameters' seed.
+cv::Mat rigPattern(const SimParameters& parameters);
+
 // The simulated rig: a scenario played on the renderer. Frame k is exposed at k / frameRate seconds and shows
 // I = O + P for even k, I' = O - P for odd k; everything in it follows from the parameters, the pattern, the
 // content and k, so any frame can be rendered alone and again.
 class Simulator {
 public:
-    // pattern: CV_8UC1, projector size, 0/1. contentImage: when not empty, shown instead of any procedural
-    // content (8-bit gray or BGR, any size: it is scaled to the display). Throws std::invalid_argument when
-    // the parameters are invalid, name an unknown scenario, or name a content that is neither a procedural
-    // kind nor "auto" and no content image is given.
+    // pattern: CV_8UC1, projector size, 0/1 (rigPattern(parameters) for the rig). contentImage: when not
+    // empty, shown instead of any procedural content (8-bit gray or BGR, any size: it is scaled to the
+    // display). Throws std::invalid_argument when the parameters are invalid, name an unknown scenario, or
+    // name a content that is neither a procedural kind nor "auto" and no content image is given.
     Simulator(const SimParameters& parameters, const cv::Mat& pattern,
               const cv::Mat& contentImage = cv::Mat());
 
