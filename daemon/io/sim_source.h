@@ -28,7 +28,6 @@ public:
 
     // Everything the renderer knows about the last frame: every fingertip, the hand mask, visible heights.
     const sim::FrameTruth& frameTruth() const { return truth_; }
-    const sim::Simulator& simulator() const { return *simulator_; }
 
 private:
     std::string spec_;

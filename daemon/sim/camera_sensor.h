@@ -24,8 +24,6 @@ public:
     // (0 B, 1 G, 2 R) at the image centre for the exposure: what metering and tests use.
     double dnPerLux(int channel, double exposureMs) const;
     double dnPerElectron() const { return dnPerElectron_; }
-    double fullWellElectrons() const { return fullWell_; }
-    double readNoiseElectrons() const { return readNoise_; }
     double blackLevelDn() const { return blackLevel_; }
 
     // Channel behind the colour filter of pixel (x, y) of an RGGB Bayer sensor: 0 B, 1 G, 2 R.

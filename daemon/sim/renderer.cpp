@@ -551,7 +551,6 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
                      frame(dirty));
     }
     dirty = cv::Rect();
-    lastPolarity_ = polarityIndex;
     castShadows(capsules, projectorBox);
     const cv::Rect shadowBox = shadowOnTable(shadowBox_);
     const cv::Rect changed = cameraBox | shadowBox;

@@ -62,10 +62,6 @@ public:
     // level at the image centre, bounded by the longest allowed exposure.
     double meterExposureMs(double ambientLux) const;
 
-    // The noise-free radiance (BGR lux) of the last render, after the camera blur: for tests.
-    const cv::Mat& radiance() const { return frameRadiance_[lastPolarity_]; }
-    const CameraSensor& sensor() const { return sensor_; }
-
 private:
     // A hand capsule ready for ray casting from both devices, with its image regions.
     struct PreparedCapsule {
@@ -127,7 +123,6 @@ private:
     double frameAmbientLux_[2] = {-1.0, -1.0};
     int frameContentVersion_[2] = {-1, -1};
     int contentVersion_ = 0;
-    int lastPolarity_ = 0;
     cv::Mat partBlurred_;     // CV_32FC3, camera size: the changed region through the camera's blur
     cv::Mat blockedOnTable_;  // CV_32FC1, camera size: shadow mask in camera pixels, in the shadow's region
     std::vector<PreparedCapsule> capsules_;

@@ -55,7 +55,6 @@ public:
     }
     cv::Size displaySize() const { return displaySize_; }
     double handScale() const { return handScale_; }
-    double mmPerDisplayPixel() const { return (onTable({1, 0}) - onTable({0, 0})).norm(); }
 
 private:
     Eigen::Matrix3d displayToTable_;

@@ -44,13 +44,9 @@ public:
     }
     // Room light on the table at `seconds`.
     double ambientLux(double seconds) const;
-    double exposureMs() const { return exposureMs_; }
 
     // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`.
     void render(std::uint64_t index, core::Frame& frame, FrameTruth& truth);
-
-    // The last render's noise-free radiance and renderer, for tests and pictures.
-    const Renderer& renderer() const { return *renderer_; }
 
 private:
     void showContent(const SceneState& scene);
