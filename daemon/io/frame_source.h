@@ -25,7 +25,7 @@ public:
     virtual std::string describe() const = 0;
 
     // Ground truth of the frame `next` returned last, when the source knows it (the simulator): one entry per
-    // finger the scene presents, possibly none. Nothing for sources without ground truth.
+    // finger the scene presents over the display, possibly none. Nothing for sources without ground truth.
     virtual std::optional<std::vector<core::FingerTruth>> truth() const { return std::nullopt; }
 };
 

@@ -33,20 +33,21 @@ SimSource::SimSource(const RigSpec& spec, bool paced) : spec_(spec.toString()), 
     }
     try {
         simulator_ = std::make_unique<sim::Simulator>(parameters, sim::rigPattern(parameters), contentImage);
+        index_ = simulator_->firstFrame();
     } catch (const std::invalid_argument& error) {
         throw InputError(input, "", error.what());
     }
 }
 
 std::optional<core::Frame> SimSource::next() {
-    if (const auto count = simulator_->frameCount(); count && index_ >= *count)
+    if (const auto end = simulator_->endFrame(); end && index_ >= *end)
         return std::nullopt;
     core::Frame frame;
     simulator_->render(index_, frame, truth_);
     truthIndex_ = index_;
     if (paced_) {
-        if (index_ == 0)
-            start_ = std::chrono::steady_clock::now();
+        if (index_ == simulator_->firstFrame())
+            start_ = std::chrono::steady_clock::now() - std::chrono::microseconds(frame.timestampUs);
         std::this_thread::sleep_until(start_ + std::chrono::microseconds(frame.timestampUs));
     }
     ++index_;
@@ -68,8 +69,10 @@ std::string SimSource::describe() const {
 
 std::optional<std::vector<core::FingerTruth>> SimSource::truth() const {
     std::vector<core::FingerTruth> fingers;
+    const cv::Size display = simulator_->calibration().displaySize;
     for (const sim::FingertipTruth& tip : truth_.fingertips)
-        if (tip.presented)
+        if (tip.presented && tip.display.x >= 0.0 && tip.display.y >= 0.0 && tip.display.x < display.width &&
+            tip.display.y < display.height)
             fingers.push_back({truthIndex_, tip.id, tip.display.x, tip.display.y, tip.heightMm});
     return fingers;
 }

@@ -154,6 +154,8 @@ const std::vector<OptionEntry>& entries() {
              p.seed = *value;
              return std::nullopt;
          }},
+        {{"start", "start the stream this many seconds into the session (default 0)"},
+         number(&SimParameters::startS)},
         {{"duration", "end the stream after this many seconds (default: endless)"},
          optionalNumber(&SimParameters::durationS)},
         {{"surface", "table surface: gray, yellow or artifacts"},

@@ -23,6 +23,8 @@ bool fraction(double value) {
 std::optional<std::string> SimParameters::validate() const {
     if (scenario.empty())
         return "scenario: empty";
+    if (!nonNegative(startS))
+        return "start: must be a number of seconds >= 0";
     if (durationS && !positive(*durationS))
         return "duration: must be a positive number of seconds";
     if (content.empty())

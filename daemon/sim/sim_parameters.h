@@ -32,6 +32,7 @@ struct SimParameters {
     // --- session ---
     std::string scenario = "demo";    // grid35, drag, multitouch, hover, palm, idle or demo
     std::uint64_t seed = 1;           // every random choice (pattern, content, motion, noise) follows from it
+    double startS = 0.0;              // the stream starts this many seconds into the session
     std::optional<double> durationS;  // the stream ends after this many seconds; endless when not set
     std::string content = "auto";     // procedural content kind (see content.h) or "auto": the scenario's own
 

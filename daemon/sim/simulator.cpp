@@ -62,10 +62,15 @@ Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, co
         parameters_.exposureMs ? *parameters_.exposureMs : renderer_->meterExposureMs(ambientLux(0.0));
 }
 
-std::optional<std::uint64_t> Simulator::frameCount() const {
+std::uint64_t Simulator::firstFrame() const {
+    return static_cast<std::uint64_t>(std::llround(parameters_.startS * parameters_.frameRate));
+}
+
+std::optional<std::uint64_t> Simulator::endFrame() const {
     if (!parameters_.durationS)
         return std::nullopt;
-    return static_cast<std::uint64_t>(std::ceil(*parameters_.durationS * parameters_.frameRate - 1e-9));
+    return firstFrame() +
+           static_cast<std::uint64_t>(std::ceil(*parameters_.durationS * parameters_.frameRate - 1e-9));
 }
 
 std::int64_t Simulator::frameTimestampUs(std::uint64_t index) const {

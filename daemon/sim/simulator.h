@@ -35,8 +35,9 @@ public:
     const cv::Mat& pattern() const { return pattern_; }
     const Scenario& scenario() const { return *scenario_; }
 
-    // Frames in the session; nothing when it is endless.
-    std::optional<std::uint64_t> frameCount() const;
+    // The stream: frames firstFrame() up to (not including) endFrame(); endless when there is no end.
+    std::uint64_t firstFrame() const;
+    std::optional<std::uint64_t> endFrame() const;
     double frameSeconds(std::uint64_t index) const { return index / parameters_.frameRate; }
     std::int64_t frameTimestampUs(std::uint64_t index) const;
     static core::Polarity framePolarity(std::uint64_t index) {

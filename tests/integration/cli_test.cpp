@@ -72,16 +72,18 @@ TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
 TEST(Everytouchd, RecordsTheSimulatedRigWithGroundTruth) {
     test::TempDir dir;
     const test::ProcessResult result =
-        test::runProcess({EVERYTOUCHD_PATH, "--rig", "sim:demo,seed=5", "--fast", "--frames", "24",
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "sim:demo,seed=5,start=3", "--fast", "--frames", "24",
                           "--record", (dir / "rec").string(), "--log", (dir / "touches.jsonl").string()});
     ASSERT_EQ(result.exitCode, 0) << result.err;
     EXPECT_THAT(result.err, HasSubstr("processed 24 frames (23 pairs)"));
     const io::Recording recording = io::Recording::open(dir / "rec");
     ASSERT_EQ(recording.frames().size(), 24u);
     EXPECT_TRUE(recording.hasTruth());
-    EXPECT_EQ(recording.truth().size(), 24u);  // one pointing finger in every frame of the demo's start
+    EXPECT_EQ(recording.truth().size(), 24u);  // 3 s into the demo one finger points at the display
+    EXPECT_EQ(recording.frames().front().index, 360u);
     EXPECT_EQ(recording.rig().calibration.cameraSize, cv::Size(648, 488));
     EXPECT_EQ(recording.frames()[1].polarity, core::Polarity::Negative);
+    EXPECT_EQ(recording.truth().front().frameIndex, 360u);
     EXPECT_EQ(recording.loadFrame(0).image.type(), CV_8UC3);
 }
 

@@ -44,10 +44,9 @@ TEST(SimSource, DeliversAlternatingFramesAtTheCameraRateUntilTheDurationEnds) {
 }
 
 TEST(SimSource, ReportsTheTruthOfThePresentedFingers) {
-    SimSource source(RigSpec::parse("sim:drag,seed=2"), false);
-    std::optional<core::Frame> frame;
-    for (int i = 0; i < 230; ++i)  // into the first drag, where the finger is down
-        frame = source.next();
+    SimSource source(RigSpec::parse("sim:drag,seed=2,start=1.9"), false);  // in the first drag, finger down
+    const std::optional<core::Frame> frame = source.next();
+    ASSERT_TRUE(frame);
     const std::optional<std::vector<core::FingerTruth>> truth = source.truth();
     ASSERT_TRUE(truth);
     ASSERT_EQ(truth->size(), 1u);  // the pointing index finger
@@ -56,6 +55,23 @@ TEST(SimSource, ReportsTheTruthOfThePresentedFingers) {
     EXPECT_EQ(truth->front().heightMm, 0.0);
     EXPECT_GT(truth->front().x, 0.0);
     EXPECT_LT(truth->front().x, 640.0);
+}
+
+TEST(SimSource, StartsIntoTheSession) {
+    SimSource source(RigSpec::parse("sim:idle,start=1,duration=0.02"), false);
+    std::vector<std::uint64_t> indices;
+    while (std::optional<core::Frame> frame = source.next()) {
+        EXPECT_EQ(frame->timestampUs, static_cast<std::int64_t>(std::llround(frame->index * 1e6 / 120.0)));
+        indices.push_back(frame->index);
+    }
+    EXPECT_EQ(indices, (std::vector<std::uint64_t>{120, 121, 122}));
+}
+
+TEST(SimSource, FingersOutsideTheDisplayAreNotInTheTruth) {
+    SimSource source(RigSpec::parse("sim:grid35"), false);  // the hand comes from beyond the display's edge
+    ASSERT_TRUE(source.next());
+    ASSERT_TRUE(source.truth());
+    EXPECT_TRUE(source.truth()->empty());
 }
 
 TEST(SimSource, IdleSceneHasTruthWithoutFingers) {
