@@ -69,8 +69,8 @@ void binarizeSubtraction(const cv::Mat& subtraction, int frameChannels, const Bi
     if (auto problem = options.validate())
         throw std::invalid_argument("BinarizationOptions: " + *problem);
     CV_Assert(subtraction.type() == CV_16SC1 && (frameChannels == 1 || frameChannels == 3));
-    cv::boxFilter(subtraction, localMean, CV_32F, {options.neighbourhood, options.neighbourhood}, {-1, -1}, true,
-                  cv::BORDER_REFLECT);
+    cv::boxFilter(subtraction, localMean, CV_32F, {options.neighbourhood, options.neighbourhood}, {-1, -1},
+                  true, cv::BORDER_REFLECT);
     codeImage.create(subtraction.size(), CV_8UC1);
 
     const double frameVariance = options.noiseSigmaDn * options.noiseSigmaDn + 1.0 / 12.0;
@@ -80,8 +80,8 @@ void binarizeSubtraction(const cv::Mat& subtraction, int frameChannels, const Bi
     const float zeroLevel = frameChannels == 3 ? kMaxOfThreeNormals * sigma : 0.0f;
     const float minAmplitude = static_cast<float>(options.minAmplitudeSigmas) * sigma;
     const float lowest = zeroLevel - static_cast<float>(options.motionSigmas) * sigma;
-    // Two levels A apart with noise sigma: a value x from the midpoint has log-likelihood ratio x A / sigma^2,
-    // and the bit is wrong with probability 1 / (1 + exp(|x| A / sigma^2)).
+    // Two levels A apart with noise sigma: a value x from the midpoint has log-likelihood ratio x A /
+    // sigma^2, and the bit is wrong with probability 1 / (1 + exp(|x| A / sigma^2)).
     const float minLogRatio =
         static_cast<float>(std::log((1.0 - options.maxErrorProbability) / options.maxErrorProbability));
     const float noiseScale = minLogRatio * sigma * sigma;
@@ -94,15 +94,11 @@ void binarizeSubtraction(const cv::Mat& subtraction, int frameChannels, const Bi
             const float amplitude = 2.0f * (threshold[x] - zeroLevel);
             const float value = s[x];
             const float excess = value - threshold[x];
-            if (amplitude < minAmplitude || value < lowest) {
-                bit[x] = kUnknownBit;
-                continue;
-            }
-            const float margin = std::max(noiseScale / amplitude, mixtureMargin * amplitude);
-            if (std::abs(excess) < margin)
-                bit[x] = kUnknownBit;
-            else
-                bit[x] = excess > 0 ? kOneBit : kZeroBit;
+            const float distance = std::abs(excess);
+            // distance * amplitude < noiseScale: the bit is wrong with a probability above the limit.
+            const bool unreadable = amplitude <= 0.0f || amplitude < minAmplitude || value < lowest ||
+                                    distance * amplitude < noiseScale || distance < mixtureMargin * amplitude;
+            bit[x] = unreadable ? kUnknownBit : excess > 0 ? kOneBit : kZeroBit;
         }
     }
 }

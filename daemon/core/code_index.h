@@ -18,7 +18,8 @@ struct CodeMatch {
     cv::Point position;  // projector pixel: the bottom-right pixel (anchor) of the matching window
     int mismatches = 0;  // Hamming distance to the observation over its known bits
     // Smallest distance of any other window the search examined (those that agree with the observation on a
-    // whole chunk); a gap to `mismatches` says how unambiguous the match is. INT_MAX when there was none.
+    // whole chunk, until no unexamined window can be closer than the best); a gap to `mismatches` says how
+    // unambiguous the match is. INT_MAX when there was none.
     int runnerUpMismatches = std::numeric_limits<int>::max();
 };
 
@@ -40,9 +41,14 @@ public:
     // bits, so any observation with at most three wrong bits and few unknown ones.
     std::optional<CodeMatch> match(const ObservedCode& observed, int maxMismatches) const;
 
+    // Expected number of windows that agree with a random observation of `knownBits` bits in all but at most
+    // `mismatches` of them: how likely a match that good is a coincidence. size() * sum_{j<=m} C(k, j) / 2^k.
+    double chanceMatches(int knownBits, int mismatches) const;
+
 private:
     static constexpr int kChunks = 4;
-    // Unknown bits of a chunk are tried both ways, up to this many (16 variants); chunks with more are skipped.
+    // Unknown bits of a chunk are tried both ways, up to this many (16 variants); chunks with more are
+    // skipped.
     static constexpr int kMaxUnknownPerChunk = 4;
 
     struct Entry {
@@ -54,7 +60,7 @@ private:
 
     int window_;
     int chunkBits_;
-    std::uint64_t codeMask_;  // the window*window bits a codeword has
+    std::uint64_t codeMask_;      // the window*window bits a codeword has
     std::vector<Entry> entries_;  // sorted by code
     // Per chunk, entries_ indices grouped by the chunk's value: those with value v are
     // chunkEntries_[c][chunkStart_[c][v]] .. chunkEntries_[c][chunkStart_[c][v + 1] - 1].

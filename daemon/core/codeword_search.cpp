@@ -12,7 +12,8 @@ namespace {
 
 // Chunks are grouped through a table with one entry per chunk value; this bounds its size (4 MB).
 constexpr int kMaxChunkBits = 20;
-// A random table lookup costs about this many codeword comparisons (a cache miss against a streamed popcount).
+// A random table lookup costs about this many codeword comparisons (a cache miss against a streamed
+// popcount).
 constexpr double kLookupCost = 8.0;
 
 // Every mask of `bits` bits with at most `radius` ones, the empty mask first.

@@ -13,15 +13,15 @@ inline constexpr int kMaxCodewordSearchRadius = 5;
 
 // Calls visit(a, b, distance) once for every pair a < b of `codes` (each codeBits long) at Hamming distance
 // <= radius. Pigeonhole: split the codewords into m chunks; two codewords within `radius` agree to within
-// radius / m bits on one chunk, so only codewords in nearby chunk groups are compared. m is chosen per call to
-// minimise the work.
+// radius / m bits on one chunk, so only codewords in nearby chunk groups are compared. m is chosen per call
+// to minimise the work.
 void forEachPairWithin(const std::vector<std::uint64_t>& codes, int codeBits, int radius,
                        const std::function<void(int a, int b, int distance)>& visit);
 
 // Codewords by id (0 .. capacity-1), each id at most once, with insertion and removal, searchable for every
-// stored codeword within `radius` of a query. Multi-index hashing: two codewords within radius r agree to within
-// r/2 bits on one of their two halves; each half has an open-addressing table holding the codewords themselves,
-// so a probe costs about one cache miss.
+// stored codeword within `radius` of a query. Multi-index hashing: two codewords within radius r agree to
+// within r/2 bits on one of their two halves; each half has an open-addressing table holding the codewords
+// themselves, so a probe costs about one cache miss.
 class NearCodewordTable {
 public:
     NearCodewordTable(int codeBits, int capacity, int radius);
@@ -64,7 +64,9 @@ private:
         int id = -1;  // -1: empty
     };
 
-    std::uint64_t halfOf(int half, std::uint64_t code) const { return half == 0 ? code & lowMask_ : code >> lowBits_; }
+    std::uint64_t halfOf(int half, std::uint64_t code) const {
+        return half == 0 ? code & lowMask_ : code >> lowBits_;
+    }
     std::size_t home(int half, std::uint64_t key) const {
         const std::uint64_t salt = half == 0 ? 0x9E3779B97F4A7C15ull : 0xC2B2AE3D27D4EB4Full;
         return static_cast<std::size_t>((key * salt) >> (64 - slotBits_));

@@ -35,9 +35,9 @@ AnchorGrid anchorGrid(cv::Size size, int window) {
     return {size.width - window + 1, size.height - window + 1, window};
 }
 
-// Counts of conflicting pairs by distance, compared lexicographically from distance 0 up: fewer identical pairs
-// first, then fewer pairs at distance 1, and so on. A repair step must make this strictly smaller, so a minimum
-// distance once reached is never lost.
+// Counts of conflicting pairs by distance, compared lexicographically from distance 0 up: fewer identical
+// pairs first, then fewer pairs at distance 1, and so on. A repair step must make this strictly smaller, so a
+// minimum distance once reached is never lost.
 using ConflictCounts = std::array<int, kMaxCodewordSearchRadius + 1>;
 
 class PatternRepair {

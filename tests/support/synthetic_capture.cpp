@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/embedding.h"
+#include "core/pattern.h"
 #include "support/test_rig.h"
 
 namespace everytouch::test {
@@ -18,8 +19,9 @@ core::Frame expose(const SyntheticScene& scene, const cv::Mat& shown, const cv::
     cv::Mat light, samples, camera;
     shown.convertTo(light, CV_32FC3);
     // Nearest-neighbour lookup keeps each projector pixel a sharp, uniformly lit square.
-    cv::warpPerspective(light, samples, projectorToSamples, {scene.cameraSize.width * ss, scene.cameraSize.height * ss},
-                        cv::INTER_NEAREST, cv::BORDER_CONSTANT, cv::Scalar::all(0));
+    cv::warpPerspective(light, samples, projectorToSamples,
+                        {scene.cameraSize.width * ss, scene.cameraSize.height * ss}, cv::INTER_NEAREST,
+                        cv::BORDER_CONSTANT, cv::Scalar::all(0));
     cv::resize(samples, camera, scene.cameraSize, 0, 0, cv::INTER_AREA);
     camera = camera * scene.gain + cv::Scalar::all(scene.ambientDn);
     camera = camera.mul(scene.albedo);
@@ -35,6 +37,11 @@ core::Frame expose(const SyntheticScene& scene, const cv::Mat& shown, const cv::
 
 }  // namespace
 
+const cv::Mat& defaultPattern() {
+    static const cv::Mat pattern = core::generatePattern({});
+    return pattern;
+}
+
 core::FramePair renderCapture(const SyntheticScene& scene) {
     CV_Assert(scene.pattern.type() == CV_8UC1 && scene.content.type() == CV_8UC3 &&
               scene.pattern.size() == scene.content.size());
@@ -43,7 +50,8 @@ core::FramePair renderCapture(const SyntheticScene& scene) {
     cv::Mat positive, negative;
     core::embedCode(scene.content, scene.pattern, scene.delta, positive, negative);
 
-    // Camera pixel (u, v) is centred on integer coordinates; its samples (U, V) sit at u = (U + 0.5) / ss - 0.5.
+    // Camera pixel (u, v) is centred on integer coordinates; its samples (U, V) sit at u = (U + 0.5) / ss -
+    // 0.5.
     const double ss = scene.supersampling;
     Eigen::Matrix3d cameraToSamples;
     cameraToSamples << ss, 0, (ss - 1) / 2, 0, ss, (ss - 1) / 2, 0, 0, 1;
@@ -99,7 +107,8 @@ cv::Mat testAlbedo(cv::Size size) {
     // A yellowish sheet: blue is mostly absorbed.
     cv::Mat yellow = albedo(cv::Rect(size.width / 2, size.height / 2, size.width / 4, size.height / 4));
     yellow.forEach<cv::Vec3f>([](cv::Vec3f& a, const int*) { a[0] *= 0.3f; });
-    cv::circle(albedo, {size.width / 4, size.height / 2}, size.height / 10, cv::Scalar::all(0.25), cv::FILLED);
+    cv::circle(albedo, {size.width / 4, size.height / 2}, size.height / 10, cv::Scalar::all(0.25),
+               cv::FILLED);
     return albedo;
 }
 

@@ -11,23 +11,26 @@
 namespace everytouch::test {
 
 // A camera capture of the projected code on a plane, rendered from known geometry for tests: the pattern is
-// embedded into content (core::embedCode), each projector pixel is a uniformly lit square, the camera integrates
-// the light over each of its pixels' footprint, the surface reflects it with its albedo together with ambient
-// light, and the sensor adds Gaussian noise and quantises to 8 bits.
+// embedded into content (core::embedCode), each projector pixel is a uniformly lit square, the camera
+// integrates the light over each of its pixels' footprint, the surface reflects it with its albedo together
+// with ambient light, and the sensor adds Gaussian noise and quantises to 8 bits.
 struct SyntheticScene {
-    cv::Mat pattern;                     // projector size, CV_8UC1, 0/1
-    cv::Mat content;                     // projector size, CV_8UC3: the image people should see
-    int delta = 10;                      // code amplitude, projector DN
-    Eigen::Matrix3d projectorToCamera;   // homography the surface induces, projector px -> camera px
-    cv::Size cameraSize{648, 488};       // pixels
-    cv::Mat albedo;                      // camera size, CV_32FC3: reflectance per channel, 0..1
-    double gain = 0.75;                  // camera DN per projector DN on a white surface
-    double ambientDn = 30;               // ambient light reflected by a white surface, DN
-    double noiseSigmaDn = 1;             // sensor noise per frame, DN
-    int supersampling = 3;               // samples per camera pixel side for the area integration
-    bool grayCamera = false;             // CV_8UC1 frames (mean of the channels) instead of CV_8UC3
-    std::uint64_t seed = 1;              // noise
+    cv::Mat pattern;                    // projector size, CV_8UC1, 0/1
+    cv::Mat content;                    // projector size, CV_8UC3: the image people should see
+    int delta = 10;                     // code amplitude, projector DN
+    Eigen::Matrix3d projectorToCamera;  // homography the surface induces, projector px -> camera px
+    cv::Size cameraSize{648, 488};      // pixels
+    cv::Mat albedo;                     // camera size, CV_32FC3: reflectance per channel, 0..1
+    double gain = 0.75;                 // camera DN per projector DN on a white surface
+    double ambientDn = 30;              // ambient light reflected by a white surface, DN
+    double noiseSigmaDn = 1;            // sensor noise per frame, DN
+    int supersampling = 3;              // samples per camera pixel side for the area integration
+    bool grayCamera = false;            // CV_8UC1 frames (mean of the channels) instead of CV_8UC3
+    std::uint64_t seed = 1;             // noise
 };
+
+// The default pattern, core::generatePattern({}), generated once per process.
+const cv::Mat& defaultPattern();
 
 // The two frames of one pair: positive shows O + P, negative O - P.
 core::FramePair renderCapture(const SyntheticScene& scene);
