@@ -13,11 +13,12 @@
 namespace {
 
 void printAnalysis(const char* name, const everytouch::core::PatternAnalysis& analysis) {
-    std::printf("%s: %zu windows, %s (%zu repeated), minimum distance %d, mean distance %.3f, mean distance to "
-                "the nearest window %.3f (means from %d samples); pairs at distance 0..%zu:",
-                name, analysis.windowCount, analysis.unique() ? "unique" : "NOT unique", analysis.repeatedWindows,
-                analysis.minDistance, analysis.meanDistance, analysis.meanNearestDistance, analysis.samples,
-                analysis.closePairs.size() - 1);
+    std::printf(
+        "%s: %zu windows, %s (%zu repeated), minimum distance %d, mean distance %.3f, mean distance to "
+        "the nearest window %.3f (means from %d samples); pairs at distance 0..%zu:",
+        name, analysis.windowCount, analysis.unique() ? "unique" : "NOT unique", analysis.repeatedWindows,
+        analysis.minDistance, analysis.meanDistance, analysis.meanNearestDistance, analysis.samples,
+        analysis.closePairs.size() - 1);
     for (std::size_t pairs : analysis.closePairs)
         std::printf(" %zu", pairs);
     std::printf("\n");
@@ -59,7 +60,8 @@ int main(int argc, char** argv) {
         core::PatternOptions plain = options;
         plain.minDistance = 0;
         const cv::Mat random = core::generatePattern(plain);
-        printAnalysis("plain random", core::analyzePattern(random, options.window, options.neighbourRadius, samples));
+        printAnalysis("plain random",
+                      core::analyzePattern(random, options.window, options.neighbourRadius, samples));
         std::printf("bits flipped by the repair: %d\n", cv::countNonZero(random != pattern));
     }
     if (!output.empty() && !cv::imwrite(output, pattern * 255)) {

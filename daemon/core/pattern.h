@@ -25,9 +25,9 @@ struct PatternOptions {
     std::uint64_t seed = 1;   // same seed, same pattern
     // Target of the repair pass: windows whose anchors are more than neighbourRadius apart differ in at least
     // this many bits. 0: no repair (the paper's plain random pattern, which repeats a codeword about every
-    // other seed at 640x480); 1: every codeword unique. With 6x6 windows on 640x480, 4 takes about 10 000
-    // trial flips (about a second); 5 is out of reach of single-bit flips (each flip then creates about 10
-    // new near pairs).
+    // other seed at 640x480); 1: every codeword unique. The pass raises the minimum one level at a time. With
+    // 6x6 windows on 640x480, 4 takes about 10 000 trial flips (under a second); 5 is out of reach of
+    // single-bit flips (each creates about 10 new near pairs): the pass spends its budget and leaves 4.
     int minDistance = 4;
     // Windows whose anchors are at most this many pixels apart (Chebyshev) may be closer than minDistance
     // (never identical): mistaking one for the other misplaces a code by that many projector pixels, which is

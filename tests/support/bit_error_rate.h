@@ -16,8 +16,8 @@ struct BitErrorFigures {
     double elevatedMismatches = 0;  // mean Hamming distance through the homography of a plane 10 mm higher
 };
 
-// Renders `scene` (its projectorToCamera must be calibration's table homography), computes S, binarises it and
-// compares every visible projector pixel with the pattern (6x6 windows).
+// Renders `scene` (its projectorToCamera must be calibration's table homography), computes S, binarises it
+// and compares every visible projector pixel with the pattern (6x6 windows).
 BitErrorFigures measureBitErrors(const SyntheticScene& scene, const core::Calibration& calibration,
                                  const core::BinarizationOptions& binarization);
 

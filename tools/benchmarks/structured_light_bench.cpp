@@ -133,7 +133,8 @@ void BM_DecodeAtFingertip(benchmark::State& state) {
     for (auto _ : state) {
         const core::CodeSample sample = core::sampleCodeAtCamera(codeImage, cameraToProjector, fingertip, 6);
         if (anchors.contains(sample.anchor))
-            distance += core::hammingDistance(core::codeAt(benchPattern(), sample.anchor, 6), sample.observed);
+            distance +=
+                core::hammingDistance(core::codeAt(benchPattern(), sample.anchor, 6), sample.observed);
         fingertip.x() = fingertip.x() < 500 ? fingertip.x() + 1 : 100;
     }
     benchmark::DoNotOptimize(distance);
@@ -153,7 +154,8 @@ void BM_CodeIndexMatch(benchmark::State& state) {
     std::vector<core::ObservedCode> observations;
     const cv::Rect anchors = core::codedRegion(benchPattern().size(), 6);
     for (int i = 0; i < 256; ++i) {
-        const cv::Point anchor(anchors.x + rng.uniform(0, anchors.width), anchors.y + rng.uniform(0, anchors.height));
+        const cv::Point anchor(anchors.x + rng.uniform(0, anchors.width),
+                               anchors.y + rng.uniform(0, anchors.height));
         core::ObservedCode observed{core::codeAt(benchPattern(), anchor, 6), (std::uint64_t{1} << 36) - 1};
         for (int k = 0; k < 2; ++k)
             observed.bits ^= std::uint64_t{1} << rng.uniform(0, 36);

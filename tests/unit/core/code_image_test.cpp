@@ -85,11 +85,13 @@ TEST(BinarizationOptions, ValidateNamesTheFieldAtFault) {
     options.mixtureMargin = 0.5;
     EXPECT_THAT(options.validate(), Optional(HasSubstr("mixtureMargin")));
     cv::Mat localMean, codeImage;
-    EXPECT_THROW(binarizeSubtraction(cv::Mat(8, 8, CV_16SC1, cv::Scalar(0)), 1, options, localMean, codeImage),
-                 std::invalid_argument);
+    EXPECT_THROW(
+        binarizeSubtraction(cv::Mat(8, 8, CV_16SC1, cv::Scalar(0)), 1, options, localMean, codeImage),
+        std::invalid_argument);
 }
 
-// S of a gray camera whose pixels each see one code bit: amplitude * bit + the difference of two frames' noise.
+// S of a gray camera whose pixels each see one code bit: amplitude * bit + the difference of two frames'
+// noise.
 struct SyntheticSubtraction {
     cv::Mat bits;  // CV_8UC1, 0/1
     cv::Mat subtraction;

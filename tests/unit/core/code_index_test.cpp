@@ -62,8 +62,8 @@ ObservedCode corrupted(std::uint64_t code, int wrong, int unknown, std::mt19937_
     return observed;
 }
 
-// With every pair of windows at least 4 bits apart, an observation with e wrong and u unknown bits is closer to
-// its own window than to any other when 2e + u < 4.
+// With every pair of windows at least 4 bits apart, an observation with e wrong and u unknown bits is closer
+// to its own window than to any other when 2e + u < 4.
 TEST(CodeIndex, MatchFindsTheWindowWhenTheMinimumDistanceGuaranteesIt) {
     const cv::Mat& pattern = quarterPanelPattern();
     const CodeIndex index(pattern, 6);
@@ -112,7 +112,8 @@ TEST(CodeIndex, MatchRejectsObservationsFartherThanAllowed) {
     const cv::Mat& pattern = quarterPanelPattern();
     const CodeIndex index(pattern, 6);
     const cv::Point anchor(100, 200);
-    ObservedCode observed{codeAt(pattern, anchor, 6) ^ 0xFFull, (std::uint64_t{1} << 36) - 1};  // 8 wrong bits
+    ObservedCode observed{codeAt(pattern, anchor, 6) ^ 0xFFull,
+                          (std::uint64_t{1} << 36) - 1};  // 8 wrong bits
     const std::optional<CodeMatch> match = index.match(observed, 3);
     if (match) {
         EXPECT_NE(match->position, anchor);

@@ -36,8 +36,8 @@ const cv::Mat& randomPattern() {
     return pattern;
 }
 
-// A camera that sees every projector pixel as 2x2 camera pixels and reads every bit perfectly. The offset keeps
-// pixel centres away from rounding ties in both directions.
+// A camera that sees every projector pixel as 2x2 camera pixels and reads every bit perfectly. The offset
+// keeps pixel centres away from rounding ties in both directions.
 struct PerfectView {
     Eigen::Matrix3d projectorToCamera;
     cv::Mat codeImage;
@@ -87,7 +87,8 @@ struct Capture {
     test::SyntheticScene scene;
     cv::Mat codeImage;
 
-    Capture(const cv::Mat& pattern, double lensMm, int delta, double noiseSigmaDn, double surfaceHeightMm = 0.0)
+    Capture(const cv::Mat& pattern, double lensMm, int delta, double noiseSigmaDn,
+            double surfaceHeightMm = 0.0)
         : calibration(test::paperLikeCalibrationWithLens(lensMm)) {
         scene.pattern = pattern;
         scene.content = test::testContent(calibration.projectorSize);
@@ -144,10 +145,11 @@ TEST(CodeSampling, AllWindowsAtOnceAgreeWithSamplingEachWindow) {
     EXPECT_EQ(agreement.mismatches.data, buffer);
 }
 
-// Where a camera pixel sees a single projector pixel, S is 2 delta gain albedo on a 1-bit and 0 on a 0-bit, and
-// T is what the surface reflects of the compressed content plus ambient light.
+// Where a camera pixel sees a single projector pixel, S is 2 delta gain albedo on a 1-bit and 0 on a 0-bit,
+// and T is what the surface reflects of the compressed content plus ambient light.
 TEST(CodeSampling, SyntheticCaptureGivesTheSubtractionAndTextureThePhysicsPredicts) {
-    const Calibration calibration = test::paperLikeCalibrationWithLens(15.0);  // 1.5 camera px per projector px
+    const Calibration calibration =
+        test::paperLikeCalibrationWithLens(15.0);  // 1.5 camera px per projector px
     test::SyntheticScene scene;
     scene.pattern = randomPattern();
     scene.content = test::testContent(calibration.projectorSize);
@@ -169,8 +171,9 @@ TEST(CodeSampling, SyntheticCaptureGivesTheSubtractionAndTextureThePhysicsPredic
     for (int y = 0; y < subtraction.rows; ++y)
         for (int x = 0; x < subtraction.cols; ++x) {
             const cv::Point p = projectorPixel(x, y);
-            if (!panel.contains(p) || projectorPixel(x - 0.5, y - 0.5) != p || projectorPixel(x + 0.5, y - 0.5) != p ||
-                projectorPixel(x - 0.5, y + 0.5) != p || projectorPixel(x + 0.5, y + 0.5) != p)
+            if (!panel.contains(p) || projectorPixel(x - 0.5, y - 0.5) != p ||
+                projectorPixel(x + 0.5, y - 0.5) != p || projectorPixel(x - 0.5, y + 0.5) != p ||
+                projectorPixel(x + 0.5, y + 0.5) != p)
                 continue;  // the camera pixel sees more than one projector pixel
             const cv::Vec3f albedo = scene.albedo.at<cv::Vec3f>(y, x);
             const int bit = scene.pattern.at<uchar>(p);
@@ -209,7 +212,8 @@ Separation separation(const Capture& capture, int points) {
             const bool onPanel = anchors.contains(sample.anchor);
             const std::uint64_t expected = onPanel ? codeAt(capture.scene.pattern, sample.anchor, 6) : 0;
             const int known = sample.observed.knownCount();
-            ratio[i++] = onPanel && known > 0 ? double(hammingDistance(expected, sample.observed)) / known : 0.5;
+            ratio[i++] =
+                onPanel && known > 0 ? double(hammingDistance(expected, sample.observed)) / known : 0.5;
         }
         tableRatios.push_back(ratio[0]);
         elevatedRatios.push_back(ratio[1]);
@@ -222,29 +226,29 @@ Separation separation(const Capture& capture, int points) {
     return {median(tableRatios), median(elevatedRatios), double(separated) / points};
 }
 
-// Paper eq. 16-18: through the right homography the observed code is the expected one up to bit errors; through
-// the homography of a plane 10 mm higher it is another window's, about half the bits off.
+// Paper eq. 16-18: through the right homography the observed code is the expected one up to bit errors;
+// through the homography of a plane 10 mm higher it is another window's, about half the bits off.
 TEST(Decoding, TheTableHomographyExplainsTheCodeAndAPlaneTenMillimetresHigherDoesNot) {
     const Separation resolving = separation(Capture(test::defaultPattern(), 10.0, 10, 2.0), 400);
-    std::printf("10 mm lens: median ratio table %.3f, 10 mm higher %.3f, separated %.3f\n", resolving.tableRatio,
-                resolving.elevatedRatio, resolving.separated);
+    std::printf("10 mm lens: median ratio table %.3f, 10 mm higher %.3f, separated %.3f\n",
+                resolving.tableRatio, resolving.elevatedRatio, resolving.separated);
     EXPECT_LT(resolving.tableRatio, 0.12);
     EXPECT_GT(resolving.elevatedRatio, 0.4);
     EXPECT_GT(resolving.separated, 0.97);
 
-    // The paper-like 6 mm lens sees a projector pixel as 0.6 camera pixels: most camera pixels mix several bits,
-    // a quarter of the bits read are wrong, and the two hypotheses separate less clearly.
+    // The paper-like 6 mm lens sees a projector pixel as 0.6 camera pixels: most camera pixels mix several
+    // bits, a quarter of the bits read are wrong, and the two hypotheses separate less clearly.
     const Separation paperLike = separation(Capture(test::defaultPattern(), 6.0, 10, 2.0), 400);
-    std::printf("6 mm lens: median ratio table %.3f, 10 mm higher %.3f, separated %.3f\n", paperLike.tableRatio,
-                paperLike.elevatedRatio, paperLike.separated);
+    std::printf("6 mm lens: median ratio table %.3f, 10 mm higher %.3f, separated %.3f\n",
+                paperLike.tableRatio, paperLike.elevatedRatio, paperLike.separated);
     EXPECT_LT(paperLike.tableRatio, 0.35);
     EXPECT_GT(paperLike.elevatedRatio, 0.4);
     EXPECT_GT(paperLike.separated, 0.8);
 }
 
-// A hand or a book 10 mm above the table: the code seen at a camera point is found on the panel through the code
-// index alone, sampling the camera image with the table's local shape; it lies where the elevated plane's
-// homography says, about 2 projector pixels from where the table's does. Noise 1 DN, delta 10.
+// A hand or a book 10 mm above the table: the code seen at a camera point is found on the panel through the
+// code index alone, sampling the camera image with the table's local shape; it lies where the elevated
+// plane's homography says, about 2 projector pixels from where the table's does. Noise 1 DN, delta 10.
 TEST(Decoding, LocatesTheCodeOnAnElevatedPlaneWithoutItsHomography) {
     const double height = 10.0;
     const Capture capture(test::defaultPattern(), 10.0, 10, 1.0, height);
@@ -267,9 +271,10 @@ TEST(Decoding, LocatesTheCodeOnAnElevatedPlaneWithoutItsHomography) {
             shift += (truth - applyHomography(onTable, point)).norm();
         }
     }
-    std::printf("elevated plane: located %d of %d, %d within 1 px of the truth (mean error %.2f px, shift from "
-                "the table's position %.2f px)\n",
-                found, points, right, error / right, shift / right);
+    std::printf(
+        "elevated plane: located %d of %d, %d within 1 px of the truth (mean error %.2f px, shift from "
+        "the table's position %.2f px)\n",
+        found, points, right, error / right, shift / right);
     // Only reads with at most about one wrong bit are significant (the rest could be chance matches): a third
     // of the points at this noise, and those are right.
     EXPECT_GT(found, 0.3 * points);

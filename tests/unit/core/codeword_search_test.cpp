@@ -11,8 +11,8 @@
 namespace everytouch::core {
 namespace {
 
-using Pair = std::tuple<int, int, int>;    // a < b, distance
-using Neighbour = std::pair<int, int>;     // id, distance
+using Pair = std::tuple<int, int, int>;  // a < b, distance
+using Neighbour = std::pair<int, int>;   // id, distance
 
 // Random codewords, a quarter of them near copies of others (0..6 bits changed) so that close pairs exist at
 // every width.
@@ -46,7 +46,8 @@ TEST(CodewordSearch, PairsWithinRadiusAreExactlyThoseOfAnExhaustiveSearch) {
             std::vector<Pair> found;
             forEachPairWithin(codes, bits, radius, [&](int a, int b, int d) { found.push_back({a, b, d}); });
             const std::set<Pair> unique(found.begin(), found.end());
-            EXPECT_EQ(unique.size(), found.size()) << "a pair reported twice, " << bits << " bits, r " << radius;
+            EXPECT_EQ(unique.size(), found.size())
+                << "a pair reported twice, " << bits << " bits, r " << radius;
             EXPECT_EQ(unique, expected) << bits << " bits, radius " << radius;
             EXPECT_FALSE(expected.empty()) << bits << " bits, radius " << radius;
         }
@@ -81,8 +82,7 @@ TEST(CodewordSearch, TableFindsExactlyTheStoredCodewordsWithinRadiusThroughInser
                 table.forEachWithin(codes[query], [&](int id, int d) { found.push_back({id, d}); });
                 const std::set<Neighbour> unique(found.begin(), found.end());
                 EXPECT_EQ(unique.size(), found.size());
-                ASSERT_EQ(unique, expected)
-                    << bits << " bits, radius " << radius << ", query " << query;
+                ASSERT_EQ(unique, expected) << bits << " bits, radius " << radius << ", query " << query;
             }
             for (int id = 0; id < count; ++id) {
                 if (stored[id]) {

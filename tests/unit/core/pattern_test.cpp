@@ -61,9 +61,9 @@ TEST(Pattern, IsBinaryOfTheRequestedSizeAndDeterminedByTheSeed) {
 
 TEST(Pattern, CodewordBitsRunRowByRowFromTheTopLeftToTheAnchor) {
     cv::Mat pattern = cv::Mat::zeros(20, 30, CV_8UC1);
-    pattern.at<uchar>(7, 10) = 1;  // row 7, column 10
+    pattern.at<uchar>(7, 10) = 1;                                    // row 7, column 10
     EXPECT_EQ(codeAt(pattern, {10, 7}, 6), std::uint64_t{1} << 35);  // the anchor is the last bit
-    EXPECT_EQ(codeAt(pattern, {15, 12}, 6), std::uint64_t{1});        // the top-left is the first
+    EXPECT_EQ(codeAt(pattern, {15, 12}, 6), std::uint64_t{1});       // the top-left is the first
     EXPECT_EQ(codeAt(pattern, {12, 9}, 6), std::uint64_t{1} << (3 * 6 + 3));
     EXPECT_EQ(codeAt(pattern, {16, 7}, 6), 0u);
     EXPECT_EQ(codedRegion(pattern.size(), 6), cv::Rect(5, 5, 25, 15));
@@ -116,7 +116,8 @@ TEST(Pattern, AnalysisAgreesWithAnExhaustiveComparisonOfAllWindows) {
                 ++closePairs[distance];
         }
     EXPECT_EQ(analysis.windowCount, codes.size());
-    EXPECT_EQ(analysis.repeatedWindows, static_cast<std::size_t>(std::count(repeated.begin(), repeated.end(), true)));
+    EXPECT_EQ(analysis.repeatedWindows,
+              static_cast<std::size_t>(std::count(repeated.begin(), repeated.end(), true)));
     EXPECT_GT(analysis.repeatedWindows, 0u);
     EXPECT_FALSE(analysis.unique());
     EXPECT_EQ(analysis.minDistance, 0);
@@ -157,12 +158,12 @@ TEST(Pattern, DefaultPatternHasUniqueWindowsAndAHigherMinimumDistanceThanPlainRa
     const int samples = 300;
     const PatternAnalysis before = analyzePattern(plain, 6, plainOptions.neighbourRadius, samples);
     const PatternAnalysis after = analyzePattern(repaired, 6, PatternOptions{}.neighbourRadius, samples);
-    std::printf("plain random: unique %d, min %d, mean %.3f, mean nearest %.3f, pairs at 0..5:", before.unique(),
-                before.minDistance, before.meanDistance, before.meanNearestDistance);
+    std::printf("plain random: unique %d, min %d, mean %.3f, mean nearest %.3f, pairs at 0..5:",
+                before.unique(), before.minDistance, before.meanDistance, before.meanNearestDistance);
     for (std::size_t pairs : before.closePairs)
         std::printf(" %zu", pairs);
-    std::printf("\nrepaired:     unique %d, min %d, mean %.3f, mean nearest %.3f, pairs at 0..5:", after.unique(),
-                after.minDistance, after.meanDistance, after.meanNearestDistance);
+    std::printf("\nrepaired:     unique %d, min %d, mean %.3f, mean nearest %.3f, pairs at 0..5:",
+                after.unique(), after.minDistance, after.meanDistance, after.meanNearestDistance);
     for (std::size_t pairs : after.closePairs)
         std::printf(" %zu", pairs);
     std::printf("\n");
