@@ -36,7 +36,8 @@ CodeSample sampleCodeAtCamera(const cv::Mat& codeImage, const Eigen::Matrix3d& c
 // grid at an unknown sub-pixel phase against the projector's pixels, which blurs bits, so the grid is tried
 // at phases x phases offsets of 1/phases pixel and the most significant match is kept. A match counts only if
 // the expected number of windows that would match as well by chance, over all phases, is at most
-// maxChanceMatches (CodeIndex::chanceMatches): with 301 625 windows, 30 known bits may have 1 mismatch.
+// maxChanceMatches (CodeIndex::chanceMatches): with 301 625 windows, 3x3 phases and the default 0.01, 29
+// known bits must all agree, 34 may have one mismatch.
 struct CodeLocation {
     Eigen::Vector2d projectorPoint;  // projector pixel seen at the camera point, to 1/phases pixel
     CodeMatch match;                 // the window read there
