@@ -24,20 +24,25 @@ Eigen::Vector2d CameraModel::undistortToNormalised(const Eigen::Vector2d& rawPix
     const double xd = (rawPixel.x() - matrix(0, 2) - matrix(0, 1) * yd) / matrix(0, 0);
     const double k1 = distortion(0), k2 = distortion(1), p1 = distortion(2), p2 = distortion(3),
                  k3 = distortion(4);
-    // Fixed-point iteration x = (x_d - tangential(x)) / radial(x), as OpenCV does, but run to convergence:
-    // estimators differentiate through this function numerically, so it must be smooth to rounding.
+    // Newton's method on distort(x) = x_d: a few iterations to rounding precision where OpenCV's fixed-point
+    // iteration stops after five at a tolerance. Estimators differentiate through this numerically, so it
+    // must be exact and smooth.
     double x = xd, y = yd;
-    constexpr int kMaxIterations = 100;
-    constexpr double kConverged = 1e-15;
+    constexpr int kMaxIterations = 20;
     for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
         const double r2 = x * x + y * y;
         const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-        const double nextX = (xd - 2.0 * p1 * x * y - p2 * (r2 + 2.0 * x * x)) / radial;
-        const double nextY = (yd - p1 * (r2 + 2.0 * y * y) - 2.0 * p2 * x * y) / radial;
-        const double change = std::abs(nextX - x) + std::abs(nextY - y);
-        x = nextX;
-        y = nextY;
-        if (change < kConverged)
+        const double radialSlope = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);  // d radial / d r2
+        const double fx = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd;
+        const double fy = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd;
+        const double jxx = radial + 2.0 * x * x * radialSlope + 2.0 * p1 * y + 6.0 * p2 * x;
+        const double jxy = 2.0 * x * y * radialSlope + 2.0 * p1 * x + 2.0 * p2 * y;
+        const double jyy = radial + 2.0 * y * y * radialSlope + 6.0 * p1 * y + 2.0 * p2 * x;
+        const double determinant = jxx * jyy - jxy * jxy;
+        const double dx = (jyy * fx - jxy * fy) / determinant, dy = (jxx * fy - jxy * fx) / determinant;
+        x -= dx;
+        y -= dy;
+        if (std::abs(dx) + std::abs(dy) < 1e-15 * (1.0 + std::abs(x) + std::abs(y)))
             break;
     }
     return {x, y};
@@ -45,6 +50,10 @@ Eigen::Vector2d CameraModel::undistortToNormalised(const Eigen::Vector2d& rawPix
 
 Eigen::Vector2d CameraModel::undistortPixel(const Eigen::Vector2d& rawPixel) const {
     return (matrix * undistortToNormalised(rawPixel).homogeneous()).hnormalized();
+}
+
+Eigen::Vector2d CameraModel::distortPixel(const Eigen::Vector2d& undistortedPixel) const {
+    return distortNormalised((matrix.inverse() * undistortedPixel.homogeneous()).hnormalized());
 }
 
 }  // namespace everytouch::core

@@ -20,6 +20,8 @@ struct CameraModel {
     Eigen::Vector2d undistortToNormalised(const Eigen::Vector2d& rawPixel) const;
     // Raw pixel -> undistorted pixel.
     Eigen::Vector2d undistortPixel(const Eigen::Vector2d& rawPixel) const;
+    // Undistorted pixel -> raw pixel.
+    Eigen::Vector2d distortPixel(const Eigen::Vector2d& undistortedPixel) const;
 };
 
 }  // namespace everytouch::core

@@ -32,6 +32,22 @@ Eigen::Vector2d applyHomography(const Eigen::Matrix3d& homography, const Eigen::
     return (homography * point.homogeneous()).hnormalized();
 }
 
+Eigen::Matrix3d rotationFromVector(const Eigen::Vector3d& rotationVector) {
+    const double angle = rotationVector.norm();
+    if (angle < 1e-12) {
+        Eigen::Matrix3d skew;
+        skew << 0, -rotationVector.z(), rotationVector.y(), rotationVector.z(), 0, -rotationVector.x(),
+            -rotationVector.y(), rotationVector.x(), 0;
+        return Eigen::Matrix3d::Identity() + skew;
+    }
+    return Eigen::AngleAxisd(angle, rotationVector / angle).toRotationMatrix();
+}
+
+Eigen::Vector3d vectorFromRotation(const Eigen::Matrix3d& rotation) {
+    const Eigen::AngleAxisd angleAxis(rotation);
+    return angleAxis.angle() * angleAxis.axis();
+}
+
 namespace {
 
 // Hartley's conditioning: moves the centroid to the origin and scales the mean distance to sqrt(2).

@@ -30,4 +30,8 @@ Eigen::Vector2d applyHomography(const Eigen::Matrix3d& homography, const Eigen::
 Eigen::Matrix3d fitHomography(const std::vector<Eigen::Vector2d>& from,
                               const std::vector<Eigen::Vector2d>& to);
 
+// Rotation vector (axis times angle, radians; Rodrigues) <-> rotation matrix.
+Eigen::Matrix3d rotationFromVector(const Eigen::Vector3d& rotationVector);
+Eigen::Vector3d vectorFromRotation(const Eigen::Matrix3d& rotation);
+
 }  // namespace everytouch::core

@@ -19,6 +19,9 @@ struct ChessboardOptions {
     cv::Size innerCorners{9, 6};
     // Edge of one square, projector pixels. The board is centred on the panel with white around it.
     int squarePx = 56;
+    // Least step between a black and a white square in the camera frame for an edge to count when the corners
+    // are refined, digital levels. A projected board on a light table steps by 100 DN or more.
+    double minEdgeStepDn = 20.0;
     // A corner further than this from the homography the other corners agree on is an outlier (camera
     // pixels). Sub-pixel corners of a flat board agree to about 0.1 px.
     double maxCornerErrorPx = 1.0;
@@ -31,12 +34,13 @@ struct ChessboardOptions {
 void renderProjectorChessboard(const ChessboardOptions& options, cv::Size projectorSize, cv::Mat& image);
 
 // The board's inner corners in projector pixels (pixel centres at integers), row by row from the top left.
-std::vector<Eigen::Vector2d> projectorChessboardCorners(const ChessboardOptions& options, cv::Size projectorSize);
+std::vector<Eigen::Vector2d> projectorChessboardCorners(const ChessboardOptions& options,
+                                                        cv::Size projectorSize);
 
 // Camera <-> projector correspondences from a camera frame of the projected board.
 struct ChessboardDetection {
     bool success = false;
-    std::string message;                          // why not, when not
+    std::string message;                            // why not, when not
     std::vector<Eigen::Vector2d> cameraCorners;     // raw camera pixels, sub-pixel
     std::vector<Eigen::Vector2d> projectorCorners;  // the same corners on the projector panel
 };
@@ -57,7 +61,8 @@ struct ProjectorToCameraEstimate {
 
 // Detects the board and fits H_CP robustly (RANSAC, then least squares on the inliers) to the corners
 // undistorted with `camera`.
-ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage, const ChessboardOptions& options,
-                                                    cv::Size projectorSize, const CameraModel& camera);
+ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage,
+                                                    const ChessboardOptions& options, cv::Size projectorSize,
+                                                    const CameraModel& camera);
 
 }  // namespace everytouch::core

@@ -1,13 +1,14 @@
 #include "core/table_rectangle.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <limits>
-#include <cmath>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/edge_profile.h"
 #include "core/geometry.h"
 
 namespace everytouch::core {
@@ -15,16 +16,6 @@ namespace everytouch::core {
 namespace {
 
 using Quad = std::array<Eigen::Vector2d, 4>;
-
-double sampleBilinear(const cv::Mat& gray, const Eigen::Vector2d& point) {
-    const double x = std::clamp(point.x(), 0.0, gray.cols - 1.001);
-    const double y = std::clamp(point.y(), 0.0, gray.rows - 1.001);
-    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-    const double fx = x - x0, fy = y - y0;
-    const auto at = [&](int row, int column) { return static_cast<double>(gray.at<uchar>(row, column)); };
-    return (1 - fy) * ((1 - fx) * at(y0, x0) + fx * at(y0, x0 + 1)) +
-           fy * ((1 - fx) * at(y0 + 1, x0) + fx * at(y0 + 1, x0 + 1));
-}
 
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return a.x() * b.y() - a.y() * b.x();
@@ -59,21 +50,26 @@ std::vector<cv::Point> offsetPolygon(const Quad& quad, double offsetPx) {
     }
     std::vector<cv::Point> polygon;
     for (int corner = 0; corner < 4; ++corner) {
-        const Eigen::Vector2d moved = intersect(sides[(corner + 3) % 4], sides[corner]).value_or(quad[corner]);
-        polygon.emplace_back(static_cast<int>(std::lround(moved.x())), static_cast<int>(std::lround(moved.y())));
+        const Eigen::Vector2d moved =
+            intersect(sides[(corner + 3) % 4], sides[corner]).value_or(quad[corner]);
+        polygon.emplace_back(static_cast<int>(std::lround(moved.x())),
+                             static_cast<int>(std::lround(moved.y())));
     }
     return polygon;
 }
 
 // Mean level inside `outer` and outside `inner` (a ring), or inside `outer` alone when inner is empty.
-double meanLevel(const cv::Mat& gray, const std::vector<cv::Point>& outer, const std::vector<cv::Point>& inner) {
+double meanLevel(const cv::Mat& gray, const std::vector<cv::Point>& outer,
+                 const std::vector<cv::Point>& inner) {
     const cv::Rect bounds = cv::boundingRect(outer) & cv::Rect(0, 0, gray.cols, gray.rows);
     if (bounds.area() == 0)
         return 0.0;
     cv::Mat mask(bounds.size(), CV_8UC1, cv::Scalar(0));
-    cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{outer}, cv::Scalar(255), cv::LINE_8, 0, -bounds.tl());
+    cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{outer}, cv::Scalar(255), cv::LINE_8, 0,
+                 -bounds.tl());
     if (!inner.empty())
-        cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{inner}, cv::Scalar(0), cv::LINE_8, 0, -bounds.tl());
+        cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{inner}, cv::Scalar(0), cv::LINE_8, 0,
+                     -bounds.tl());
     return cv::mean(gray(bounds), mask)[0];
 }
 
@@ -89,10 +85,8 @@ struct EdgeFit {
     int points = 0;
 };
 
-// Sub-pixel points of the edge from `from` to `to` (raw pixels) of a dark region (the inside is on the side of
-// `inside`), undistorted, and a line fitted through them. Each point comes from a level profile across the
-// edge: the area between the profile and its light level, divided by the step from dark to light, is the
-// distance from the profile's dark end to the edge, whatever the blur. The ends of the side are skipped.
+// Sub-pixel points of the edge from `from` to `to` (raw pixels) of a dark region (the inside is on the side
+// of `inside`), undistorted, and a line fitted through them. The ends of the side are skipped.
 std::optional<EdgeFit> fitEdge(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
                                const Eigen::Vector2d& inside, double reachPx, double minStepDn,
                                const CameraModel& camera) {
@@ -102,32 +96,15 @@ std::optional<EdgeFit> fitEdge(const cv::Mat& gray, const Eigen::Vector2d& from,
         outward = -outward;
     const double length = (to - from).norm();
     constexpr double kSkippedEnd = 0.08;  // fraction of the side left out at each end
-    constexpr double kProfileStepPx = 0.25;
-    const int profileSamples = static_cast<int>(2.0 * reachPx / kProfileStepPx) + 1;
-    const int endSamples = std::max(2, profileSamples / 8);
 
     std::vector<cv::Point2f> edgePoints;
-    std::vector<double> profile(profileSamples);
     for (double position = kSkippedEnd * length; position <= (1.0 - kSkippedEnd) * length; position += 0.5) {
         const Eigen::Vector2d base = from + along * position;
-        for (int sample = 0; sample < profileSamples; ++sample)
-            profile[sample] = sampleBilinear(gray, base + outward * (-reachPx + sample * kProfileStepPx));
-        double dark = 0, light = 0;
-        for (int sample = 0; sample < endSamples; ++sample) {
-            dark += profile[sample];
-            light += profile[profileSamples - 1 - sample];
-        }
-        dark /= endSamples;
-        light /= endSamples;
-        if (light - dark < minStepDn)
-            continue;
-        double area = 0.0;  // trapezoid rule
-        for (int sample = 0; sample + 1 < profileSamples; ++sample)
-            area += (2.0 * light - profile[sample] - profile[sample + 1]) / 2.0 * kProfileStepPx;
-        const double offset = -reachPx + area / (light - dark);
-        if (std::abs(offset) > reachPx)
-            continue;
-        const Eigen::Vector2d edge = camera.undistortPixel(base + outward * offset);
+        const std::optional<EdgeCrossing> crossing =
+            locateEdgeCrossing(gray, base, outward, reachPx, minStepDn);
+        if (!crossing || crossing->stepDn < 0)
+            continue;  // no edge, or dark outside
+        const Eigen::Vector2d edge = camera.undistortPixel(base + outward * crossing->offsetPx);
         edgePoints.emplace_back(static_cast<float>(edge.x()), static_cast<float>(edge.y()));
     }
     constexpr size_t kMinEdgePoints = 3;
@@ -290,8 +267,7 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         if (refined) {
             Quad raw;
             for (int corner = 0; corner < 4; ++corner)
-                raw[corner] = camera.distortNormalised(
-                    (camera.matrix.inverse() * refined->corners[corner].homogeneous()).hnormalized());
+                raw[corner] = camera.distortPixel(refined->corners[corner]);
             refined = refineQuad(gray, raw, reachPx, options.minContrastDn / 2.0, camera);
         }
         if (!refined)
@@ -318,14 +294,14 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         detection.message = message;
         return detection;
     }
-    const Candidate& best = *std::min_element(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-        return std::abs(a.aspectError) < std::abs(b.aspectError);
-    });
+    const Candidate& best = *std::min_element(
+        candidates.begin(), candidates.end(),
+        [](const auto& a, const auto& b) { return std::abs(a.aspectError) < std::abs(b.aspectError); });
 
     detection.corners = tableOrder(best.corners);
     const double w = options.sizeMm.width, h = options.sizeMm.height;
-    detection.tableToCamera = fitHomography({{0, 0}, {w, 0}, {w, h}, {0, h}},
-                                            {detection.corners.begin(), detection.corners.end()});
+    detection.tableToCamera =
+        fitHomography({{0, 0}, {w, 0}, {w, h}, {0, h}}, {detection.corners.begin(), detection.corners.end()});
     detection.edgeRmsPx = best.edgeRmsPx;
     detection.contrastDn = best.contrastDn;
     detection.success = true;

@@ -39,6 +39,7 @@ TEST(CameraModel, UndistortionInvertsDistortionAcrossTheFrame) {
             EXPECT_LT((camera.undistortToNormalised(raw) - Eigen::Vector2d(x, y)).norm(), 1e-12);
             const Eigen::Vector2d ideal = (camera.matrix * Eigen::Vector3d(x, y, 1)).hnormalized();
             EXPECT_LT((camera.undistortPixel(raw) - ideal).norm(), 1e-9);
+            EXPECT_LT((camera.distortPixel(ideal) - raw).norm(), 1e-9);
         }
     }
 }
