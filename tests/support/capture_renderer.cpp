@@ -1,11 +1,11 @@
 #include "support/capture_renderer.h"
 
 #include <cmath>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "core/camera_model.h"
-#include "core/geometry.h"
 
 namespace everytouch::test {
 
@@ -35,26 +35,40 @@ cv::Mat renderCapture(const SurfaceScene& scene, const cv::Mat& projectorImage, 
                       unsigned seed, int supersampling) {
     CV_Assert(projectorImage.type() == CV_8UC1 && projectorImage.size() == scene.rig.projectorSize);
     const core::CameraModel camera{scene.rig.cameraMatrix, scene.rig.cameraDistortion};
-    const Eigen::Isometry3d cameraToSurface = scene.rig.tableToCamera.inverse();
-    const Eigen::Vector3d normal = scene.rig.tableToCamera.rotation().col(2);
-    const double normalDotOrigin = normal.dot(scene.rig.tableToCamera.translation());
+    // Viewing rays (normalised undistorted coordinates) at the pixels' corners; inside a pixel the lens is
+    // linear to far below a thousandth of a pixel, so the samples interpolate them.
+    const cv::Size size = scene.rig.cameraSize;
+    std::vector<Eigen::Vector2d> cornerRays((size.width + 1) * (size.height + 1));
+    for (int v = 0; v <= size.height; ++v)
+        for (int u = 0; u <= size.width; ++u)
+            cornerRays[v * (size.width + 1) + u] = camera.undistortToNormalised({u - 0.5, v - 0.5});
+    // Ray (x, y, 1) -> surface millimetres and -> projector pixels, through the plane-induced homographies.
+    Eigen::Matrix3d surfaceToRay = scene.rig.tableToCamera.matrix().block<3, 3>(0, 0);
+    surfaceToRay.col(2) = scene.rig.tableToCamera.translation();
+    const Eigen::Matrix3d rayToSurfaceHomography = surfaceToRay.inverse();
+    const Eigen::Matrix3d rayToProjector = scene.rig.tableToProjectorHomography() * rayToSurfaceHomography;
 
-    cv::Mat radiance(scene.rig.cameraSize, CV_64FC1);
+    cv::Mat radiance(size, CV_64FC1);
     const double step = 1.0 / supersampling;
-    for (int v = 0; v < radiance.rows; ++v) {
-        for (int u = 0; u < radiance.cols; ++u) {
+    for (int v = 0; v < size.height; ++v) {
+        for (int u = 0; u < size.width; ++u) {
+            const Eigen::Vector2d& topLeft = cornerRays[v * (size.width + 1) + u];
+            const Eigen::Vector2d& topRight = cornerRays[v * (size.width + 1) + u + 1];
+            const Eigen::Vector2d& bottomLeft = cornerRays[(v + 1) * (size.width + 1) + u];
+            const Eigen::Vector2d& bottomRight = cornerRays[(v + 1) * (size.width + 1) + u + 1];
             double sum = 0.0;
             for (int j = 0; j < supersampling; ++j) {
+                const double fy = (j + 0.5) * step;
+                const Eigen::Vector2d left = (1 - fy) * topLeft + fy * bottomLeft;
+                const Eigen::Vector2d right = (1 - fy) * topRight + fy * bottomRight;
                 for (int i = 0; i < supersampling; ++i) {
-                    const Eigen::Vector2d raw(u - 0.5 + (i + 0.5) * step, v - 0.5 + (j + 0.5) * step);
-                    const Eigen::Vector3d ray = camera.undistortToNormalised(raw).homogeneous();
-                    const double depth = normalDotOrigin / normal.dot(ray);
-                    if (!(depth > 0))
+                    const double fx = (i + 0.5) * step;
+                    const Eigen::Vector3d ray = ((1 - fx) * left + fx * right).homogeneous();
+                    const Eigen::Vector3d onSurface = rayToSurfaceHomography * ray;
+                    if (!(onSurface.z() > 0))
                         continue;  // the ray misses the surface (looks above its horizon)
-                    const Eigen::Vector3d onSurface = cameraToSurface * (depth * ray);
-                    const Eigen::Vector2d pointMm = onSurface.head<2>();
-                    const Eigen::Vector2d projector =
-                        core::projectPoint(scene.rig.projectorMatrix, scene.rig.tableToProjector, onSurface);
+                    const Eigen::Vector2d pointMm = onSurface.hnormalized();
+                    const Eigen::Vector2d projector = (rayToProjector * ray).hnormalized();
                     sum += reflectance(scene, pointMm) *
                            (scene.ambientDn + scene.projectorGainDn * projectorLevel(projectorImage, projector));
                 }
