@@ -1,4 +1,5 @@
 // everytouchd: turns a table seen by a camera and lit by a projector into a multitouch screen.
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -9,6 +10,7 @@
 #include "io/input_error.h"
 #include "io/log.h"
 #include "io/touch_log.h"
+#include "io/uinput_sink.h"
 #include "service/daemon_options.h"
 #include "service/frame_loop.h"
 #include "service/frame_sources.h"
@@ -52,6 +54,21 @@ int run(const everytouch::service::DaemonOptions& options) {
         sinks.push_back(touchLog.get());
     }
 
+    std::unique_ptr<io::UinputSink> touchscreen;
+    if (std::ranges::find(options.outputs, "uinput") != options.outputs.end()) {
+        const std::optional<io::RigDescription> rig = source->rig();
+        if (!rig)
+            throw io::InputError("--output uinput", "",
+                                 "this rig does not describe itself; the touchscreen's size comes from its "
+                                 "calibration");
+        touchscreen = std::make_unique<io::UinputSink>(rig->calibration);
+        const cv::Size2d sizeMm = touchscreen->axes().sizeMm();
+        ET_LOG(Info) << "virtual touchscreen " << touchscreen->devnode() << ": "
+                     << rig->calibration.displaySize.width << "x" << rig->calibration.displaySize.height
+                     << " px, " << sizeMm.width << "x" << sizeMm.height << " mm";
+        sinks.push_back(touchscreen.get());
+    }
+
     installStopHandlers();
     service::FrameLoop loop(*source, sinks, recorder.get(), options.maxFrames);
     const service::LoopStatistics statistics = loop.run(stopRequested);
@@ -75,6 +92,9 @@ int main(int argc, char** argv) {
                    "Frame source: sim[:SCENARIO][,key=value...], replay:DIR, aravis[:ID] or v4l2:/dev/videoN")
         ->capture_default_str();
     app.add_option("--log", options.touchLog, "Write the touch log (JSON Lines) to FILE; - for stdout");
+    app.add_option("--output", options.outputs,
+                   "Send contacts to OUTPUT too: uinput (the virtual touchscreen)")
+        ->delimiter(',');
     app.add_option("--record", options.recordDir, "Record every frame into the new directory DIR");
     app.add_option("--frames", options.maxFrames, "Stop after N camera frames (0: run until the rig ends)");
     app.add_flag("--fast", options.fast, "Do not pace sim and replay rigs in real time");

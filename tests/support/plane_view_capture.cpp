@@ -13,7 +13,7 @@ CapturedView captureView(const core::Calibration& surfaceRig, const std::optiona
     cv::Mat board;
     core::renderProjectorChessboard(chessboard, surfaceRig.projectorSize, board);
     const core::ChessboardDetection corners = core::detectProjectedChessboard(
-        renderCapture(scene, board, noiseSigmaDn, seed), chessboard, surfaceRig.projectorSize);
+        renderSurface(scene, board, noiseSigmaDn, seed), chessboard, surfaceRig.projectorSize);
     if (!corners.success) {
         captured.failure = corners.message;
         return captured;
@@ -28,7 +28,7 @@ CapturedView captureView(const core::Calibration& surfaceRig, const std::optiona
     core::TableRectangleOptions options;
     options.sizeMm = rectangle->sizeMm;
     const core::TableRectangleDetection found =
-        core::findTableRectangle(renderCapture(scene, white, noiseSigmaDn, seed + 1), options, knownCamera);
+        core::findTableRectangle(renderSurface(scene, white, noiseSigmaDn, seed + 1), options, knownCamera);
     if (!found.success) {
         captured.failure = found.message;
         return captured;

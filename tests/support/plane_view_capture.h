@@ -7,7 +7,7 @@
 #include "core/camera_model.h"
 #include "core/plane_view.h"
 #include "core/projector_chessboard.h"
-#include "support/capture_renderer.h"
+#include "support/surface_renderer.h"
 
 namespace everytouch::test {
 

@@ -1,5 +1,10 @@
 #pragma once
 
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,5 +19,26 @@ struct ProcessResult {
 // Runs a program to completion with the given arguments, capturing its output. Fails the test if it cannot
 // start.
 ProcessResult runProcess(const std::vector<std::string>& argv);
+
+// A program running beside the test (searched in $PATH), its stdout and stderr going to `outputFile`.
+// Killed and reaped when the object goes, unless it ended before.
+class BackgroundProcess {
+public:
+    BackgroundProcess(const std::vector<std::string>& argv, const std::filesystem::path& outputFile);
+    ~BackgroundProcess();
+    BackgroundProcess(const BackgroundProcess&) = delete;
+    BackgroundProcess& operator=(const BackgroundProcess&) = delete;
+
+    pid_t pid() const { return pid_; }
+    // Whether the program holds `file` open right now.
+    bool hasOpen(const std::filesystem::path& file) const;
+    void signal(int number) const;
+    // The exit status (128 + signal number when killed), or nothing if it is still running after `timeout`.
+    std::optional<int> wait(std::chrono::milliseconds timeout);
+
+private:
+    pid_t pid_ = -1;
+    std::optional<int> exitCode_;
+};
 
 }  // namespace everytouch::test

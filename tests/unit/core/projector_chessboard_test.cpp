@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/geometry.h"
-#include "support/capture_renderer.h"
+#include "support/surface_renderer.h"
 #include "support/test_rig.h"
 
 namespace everytouch::core {
@@ -62,7 +62,7 @@ TEST_P(ProjectedChessboard, RecoversTheProjectorToCameraHomography) {
     const ChessboardOptions options;
     cv::Mat board;
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
-    const cv::Mat capture = test::renderCapture(scene, board, noiseSigmaDn);
+    const cv::Mat capture = test::renderSurface(scene, board, noiseSigmaDn);
 
     const ProjectorToCameraEstimate estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, CameraModel{});
@@ -89,7 +89,7 @@ TEST(ProjectorChessboard, TellsTheBoardFromItsHalfTurn) {
     const ChessboardOptions options;
     cv::Mat board;
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
-    const cv::Mat capture = test::renderCapture(scene, board);
+    const cv::Mat capture = test::renderSurface(scene, board);
     const ProjectorToCameraEstimate estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, CameraModel{});
     ASSERT_TRUE(estimate.success) << estimate.message;
@@ -105,7 +105,7 @@ TEST(ProjectorChessboard, UndistortsTheCornersWithTheCameraModel) {
     const ChessboardOptions options;
     cv::Mat board;
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
-    const cv::Mat capture = test::renderCapture(scene, board);
+    const cv::Mat capture = test::renderSurface(scene, board);
     const CameraModel camera{scene.rig.cameraMatrix, scene.rig.cameraDistortion};
     const ProjectorToCameraEstimate estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, camera);
@@ -121,7 +121,7 @@ TEST(ProjectorChessboard, FrameWithoutABoardFailsQuickly) {
     scene.rig = test::paperLikeCalibration();
     scene.rectangles.push_back({});  // a card, nothing like a board
     const cv::Mat white(scene.rig.projectorSize, CV_8UC1, cv::Scalar(255));
-    const cv::Mat capture = test::renderCapture(scene, white, 2.0);
+    const cv::Mat capture = test::renderSurface(scene, white, 2.0);
     const auto start = std::chrono::steady_clock::now();
     const ChessboardDetection detection = detectProjectedChessboard(capture, {}, scene.rig.projectorSize);
     const double elapsedMs =

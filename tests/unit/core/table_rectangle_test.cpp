@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "core/geometry.h"
-#include "support/capture_renderer.h"
+#include "support/surface_renderer.h"
 #include "support/test_rig.h"
 
 namespace everytouch::core {
@@ -57,7 +57,7 @@ class StripeOnTable : public ::testing::TestWithParam<double> {};
 TEST_P(StripeOnTable, FindsTheCornersToAFractionOfAPixel) {
     const double noiseSigmaDn = GetParam();
     const test::SurfaceScene scene = stripeOnTable();
-    const cv::Mat capture = test::renderCapture(scene, whiteProjection(scene.rig), noiseSigmaDn);
+    const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), noiseSigmaDn);
     const TableRectangleDetection detection = findTableRectangle(capture, {});
     ASSERT_TRUE(detection.success) << detection.message;
     const double worst = worstCornerError(detection, trueCorners(scene, scene.rectangles[0]));
@@ -81,7 +81,7 @@ TEST(TableRectangle, IgnoresDarkThingsOfOtherShapes) {
     cardSized.sizeMm = {85.6, 54};
     cardSized.albedo = 0.3;
     scene.rectangles.insert(scene.rectangles.end(), {square, line, cardSized});
-    const cv::Mat capture = test::renderCapture(scene, whiteProjection(scene.rig), 2.0);
+    const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
     const TableRectangleDetection detection = findTableRectangle(capture, {});
     ASSERT_TRUE(detection.success) << detection.message;
     EXPECT_LT(worstCornerError(detection, trueCorners(scene, scene.rectangles[0])), 0.2);
@@ -95,7 +95,7 @@ TEST(TableRectangle, FindsAWholeDarkCardGivenItsSize) {
     card.sizeMm = {85.6, 54};
     card.angleRad = -0.2;
     scene.rectangles.push_back(card);
-    const cv::Mat capture = test::renderCapture(scene, whiteProjection(scene.rig), 2.0);
+    const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
     TableRectangleOptions options;
     options.sizeMm = card.sizeMm;
     const TableRectangleDetection detection = findTableRectangle(capture, options);
@@ -106,7 +106,7 @@ TEST(TableRectangle, FindsAWholeDarkCardGivenItsSize) {
 TEST(TableRectangle, ReportsUndistortedPixelsOfTheCameraModel) {
     test::SurfaceScene scene = stripeOnTable();
     scene.rig.cameraDistortion << -0.2, 0.1, 0, 0, 0;
-    const cv::Mat capture = test::renderCapture(scene, whiteProjection(scene.rig));
+    const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig));
     const TableRectangleDetection detection =
         findTableRectangle(capture, {}, CameraModel{scene.rig.cameraMatrix, scene.rig.cameraDistortion});
     ASSERT_TRUE(detection.success) << detection.message;
@@ -116,7 +116,7 @@ TEST(TableRectangle, ReportsUndistortedPixelsOfTheCameraModel) {
 TEST(TableRectangle, TableWithoutTheRectangleFailsWithAMessage) {
     test::SurfaceScene scene;
     scene.rig = test::paperLikeCalibration();
-    const cv::Mat capture = test::renderCapture(scene, whiteProjection(scene.rig), 2.0);
+    const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
     const TableRectangleDetection detection = findTableRectangle(capture, {});
     EXPECT_FALSE(detection.success);
     EXPECT_THAT(detection.message, HasSubstr("no dark rectangle of 85.5 x 12.5 mm"));

@@ -1,4 +1,4 @@
-#include "support/capture_renderer.h"
+#include "support/surface_renderer.h"
 
 #include <cmath>
 #include <vector>
@@ -31,7 +31,7 @@ double projectorLevel(const cv::Mat& projectorImage, const Eigen::Vector2d& pixe
 
 }  // namespace
 
-cv::Mat renderCapture(const SurfaceScene& scene, const cv::Mat& projectorImage, double noiseSigmaDn,
+cv::Mat renderSurface(const SurfaceScene& scene, const cv::Mat& projectorImage, double noiseSigmaDn,
                       unsigned seed, int supersampling) {
     CV_Assert(projectorImage.type() == CV_8UC1 && projectorImage.size() == scene.rig.projectorSize);
     const core::CameraModel camera{scene.rig.cameraMatrix, scene.rig.cameraDistortion};

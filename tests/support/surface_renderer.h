@@ -32,7 +32,7 @@ struct SurfaceScene {
 // The 8-bit gray camera frame of the scene while the projector shows `projectorImage` (8-bit gray, projector
 // size), with the camera's lens distortion. Each camera pixel integrates supersampling x supersampling rays;
 // projector pixels are sharp squares. Gaussian noise of noiseSigmaDn is added before quantisation.
-cv::Mat renderCapture(const SurfaceScene& scene, const cv::Mat& projectorImage, double noiseSigmaDn = 0.0,
+cv::Mat renderSurface(const SurfaceScene& scene, const cv::Mat& projectorImage, double noiseSigmaDn = 0.0,
                       unsigned seed = 1, int supersampling = 4);
 
 // The scene's surface moved by `surfaceToTable` (a board lifted and tilted above the table): the calibration
