@@ -38,13 +38,47 @@ double typicalMagnitude(int parameter, bool rectangleView, int viewParameter) {
     return 1.0 / 500.0;
 }
 
+// The least squares moves the free parameters; with square pixels each device's fy is its fx and not free.
+class ParameterLayout {
+public:
+    ParameterLayout(bool squarePixels, int fullCount) {
+        for (int parameter = 0; parameter < fullCount; ++parameter)
+            if (!squarePixels || (parameter != 1 && parameter != 7))
+                freeToFull_.push_back(parameter);
+        expansion_ = Eigen::MatrixXd::Zero(fullCount, freeCount());
+        for (int free = 0; free < freeCount(); ++free)
+            expansion_(freeToFull_[free], free) = 1.0;
+        if (squarePixels) {
+            expansion_(1, 0) = 1.0;  // camera fy = fx
+            expansion_(7, 5) = 1.0;  // projector fy = fx
+        }
+    }
+
+    int freeCount() const { return static_cast<int>(freeToFull_.size()); }
+    // The full parameter a free one stands for (the first of those it sets).
+    int fullIndex(int free) const { return freeToFull_[free]; }
+    Eigen::VectorXd expand(const Eigen::VectorXd& free) const { return expansion_ * free; }
+    Eigen::VectorXd reduce(const Eigen::VectorXd& full) const {
+        Eigen::VectorXd free(freeCount());
+        for (int index = 0; index < freeCount(); ++index)
+            free(index) = full(freeToFull_[index]);
+        return free;
+    }
+    const Eigen::MatrixXd& expansion() const { return expansion_; }
+
+private:
+    std::vector<int> freeToFull_;
+    Eigen::MatrixXd expansion_;  // full = expansion * free
+};
+
 Eigen::Matrix3d intrinsics(const double* parameters) {
     Eigen::Matrix3d matrix;
     matrix << parameters[0], 0, parameters[2], 0, parameters[1], parameters[3], 0, 0, 1;
     return matrix;
 }
 
-ProjectorCameraPair pairFromParameters(const Eigen::VectorXd& parameters, const PairCalibrationOptions& options) {
+ProjectorCameraPair pairFromParameters(const Eigen::VectorXd& parameters,
+                                       const PairCalibrationOptions& options) {
     ProjectorCameraPair pair;
     pair.cameraSize = options.cameraSize;
     pair.projectorSize = options.projectorSize;
@@ -73,9 +107,12 @@ Eigen::Vector3d inverseDepthOf(const Eigen::Hyperplane<double, 3>& plane) {
 
 class PairResiduals : public Eigen::DenseFunctor<double> {
 public:
-    PairResiduals(const std::vector<PlaneView>& views, const PairCalibrationOptions& options, int parameters,
-                  int residuals)
-        : Eigen::DenseFunctor<double>(parameters, residuals), views_(&views), options_(&options) {
+    PairResiduals(const std::vector<PlaneView>& views, const PairCalibrationOptions& options,
+                  const ParameterLayout& layout, int residuals)
+        : Eigen::DenseFunctor<double>(layout.freeCount(), residuals),
+          views_(&views),
+          options_(&options),
+          layout_(&layout) {
         int parameter = kPairParameters, residual = 0;
         for (const PlaneView& view : views) {
             parameterOffsets_.push_back(parameter);
@@ -85,7 +122,8 @@ public:
         }
     }
 
-    int operator()(const Eigen::VectorXd& parameters, Eigen::VectorXd& residuals) const {
+    int operator()(const Eigen::VectorXd& free, Eigen::VectorXd& residuals) const {
+        const Eigen::VectorXd parameters = layout_->expand(free);
         const ProjectorCameraPair pair = pairFromParameters(parameters, *options_);
         for (size_t view = 0; view < views_->size(); ++view)
             evaluateView(pair, parameters, view, residuals.data() + residualOffsets_[view]);
@@ -93,30 +131,34 @@ public:
     }
 
     // Forward differences, exploiting that a view's surface parameters touch only that view's residuals.
-    int df(const Eigen::VectorXd& parameters, Eigen::MatrixXd& jacobian) const {
+    int df(const Eigen::VectorXd& free, Eigen::MatrixXd& jacobian) const {
         Eigen::VectorXd base(values()), moved(values());
-        (*this)(parameters, base);
+        (*this)(free, base);
         jacobian.setZero(values(), inputs());
-        Eigen::VectorXd shifted = parameters;
+        const Eigen::VectorXd parameters = layout_->expand(free);
         const ProjectorCameraPair pair = pairFromParameters(parameters, *options_);
-        for (int parameter = 0; parameter < inputs(); ++parameter) {
-            const int view = viewOf(parameter);
+        Eigen::VectorXd shifted = free;
+        for (int index = 0; index < inputs(); ++index) {
+            const int full = layout_->fullIndex(index);
+            const int view = viewOf(full);
             const bool rectangleView = view >= 0 && (*views_)[view].rectangleCorners.has_value();
-            const double step =
-                std::sqrt(std::numeric_limits<double>::epsilon()) *
-                std::max(std::abs(parameters(parameter)),
-                         typicalMagnitude(parameter, rectangleView, view >= 0 ? parameter - parameterOffsets_[view] : 0));
-            shifted(parameter) = parameters(parameter) + step;
+            const double step = std::sqrt(std::numeric_limits<double>::epsilon()) *
+                                std::max(std::abs(free(index)),
+                                         typicalMagnitude(full, rectangleView,
+                                                          view >= 0 ? full - parameterOffsets_[view] : 0));
+            shifted(index) = free(index) + step;
             if (view < 0) {
                 (*this)(shifted, moved);
-                jacobian.col(parameter) = (moved - base) / step;
+                jacobian.col(index) = (moved - base) / step;
             } else {
                 const int first = residualOffsets_[view], count = residualCount((*views_)[view]);
-                evaluateView(pair, shifted, view, moved.data() + first);
-                jacobian.col(parameter).segment(first, count) =
+                Eigen::VectorXd surface = parameters;
+                surface(full) = shifted(index);
+                evaluateView(pair, surface, view, moved.data() + first);
+                jacobian.col(index).segment(first, count) =
                     (moved.segment(first, count) - base.segment(first, count)) / step;
             }
-            shifted(parameter) = parameters(parameter);
+            shifted(index) = free(index);
         }
         return 0;
     }
@@ -124,7 +166,7 @@ public:
     int parameterOffset(size_t view) const { return parameterOffsets_[view]; }
 
 private:
-    // The view a surface parameter belongs to; -1 for the pair's parameters.
+    // The view a full parameter belongs to; -1 for the pair's parameters.
     int viewOf(int parameter) const {
         if (parameter < kPairParameters)
             return -1;
@@ -141,13 +183,15 @@ private:
             planeViewResiduals(pair, planeOf(rectangleToCamera), planeView, rectangleToCamera,
                                options_->rectangleSizeMm, residuals);
         } else {
-            planeViewResiduals(pair, planeFromInverseDepth(Eigen::Map<const Eigen::Vector3d>(surface)), planeView,
-                               Eigen::Isometry3d::Identity(), options_->rectangleSizeMm, residuals);
+            planeViewResiduals(pair, planeFromInverseDepth(Eigen::Map<const Eigen::Vector3d>(surface)),
+                               planeView, Eigen::Isometry3d::Identity(), options_->rectangleSizeMm,
+                               residuals);
         }
     }
 
     const std::vector<PlaneView>* views_;
     const PairCalibrationOptions* options_;
+    const ParameterLayout* layout_;
     std::vector<int> parameterOffsets_;
     std::vector<int> residualOffsets_;
 };
@@ -156,8 +200,8 @@ std::vector<Eigen::Vector2d> rectangleModel(cv::Size2d sizeMm) {
     return {{0, 0}, {sizeMm.width, 0}, {sizeMm.width, sizeMm.height}, {0, sizeMm.height}};
 }
 
-// Focal length from the rectangles' homographies (rectangle mm -> raw camera pixels) with the principal point at
-// `centre` and square pixels: Zhang's two constraints per view, r1 . r2 = 0 and |r1| = |r2|, in 1 / f^2.
+// Focal length from the rectangles' homographies (rectangle mm -> raw camera pixels) with the principal point
+// at `centre` and square pixels: Zhang's two constraints per view, r1 . r2 = 0 and |r1| = |r2|, in 1 / f^2.
 std::optional<double> focalFromRectangles(const std::vector<Eigen::Matrix3d>& homographies,
                                           const Eigen::Vector2d& centre) {
     double numerator = 0.0, denominator = 0.0;
@@ -199,8 +243,8 @@ Eigen::Isometry3d poseFromHomography(const Eigen::Matrix3d& homography, const Ei
 
 Eigen::Isometry3d toIsometry(const cv::Mat& rotationVector, const cv::Mat& translation) {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    pose.linear() = rotationFromVector({rotationVector.at<double>(0), rotationVector.at<double>(1),
-                                        rotationVector.at<double>(2)});
+    pose.linear() = rotationFromVector(
+        {rotationVector.at<double>(0), rotationVector.at<double>(1), rotationVector.at<double>(2)});
     pose.translation() << translation.at<double>(0), translation.at<double>(1), translation.at<double>(2);
     return pose;
 }
@@ -223,7 +267,8 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
         if (view.rectangleCorners)
             homographies.push_back(
                 fitHomography(model, {view.rectangleCorners->begin(), view.rectangleCorners->end()}));
-    // A rectangle seen nearly head-on says little about the focal length; a typical lens then is a better start.
+    // A rectangle seen nearly head-on says little about the focal length; a typical lens then is a better
+    // start.
     const double fallbackFocal = static_cast<double>(options.cameraSize.width);
     double focal = focalFromRectangles(homographies, centre).value_or(fallbackFocal);
     if (focal < 0.3 * fallbackFocal || focal > 10.0 * fallbackFocal)
@@ -260,9 +305,10 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
     cv::Mat projectorMatrix, projectorDistortion;
     std::vector<cv::Mat> rotations, translations;
     try {
-        cv::calibrateCamera(objectPoints, imagePoints, options.projectorSize, projectorMatrix, projectorDistortion,
-                            rotations, translations,
-                            cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3);
+        cv::calibrateCamera(
+            objectPoints, imagePoints, options.projectorSize, projectorMatrix, projectorDistortion, rotations,
+            translations,
+            cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3);
     } catch (const cv::Exception& error) {
         estimate.failure = std::string("initial projector estimate failed: ") + error.what();
         return estimate;
@@ -289,8 +335,8 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
 
     Eigen::VectorXd& parameters = estimate.parameters;
     parameters.head<4>() << focal, focal, centre.x(), centre.y();
-    parameters.segment<4>(6) << pair.projectorMatrix(0, 0), pair.projectorMatrix(1, 1), pair.projectorMatrix(0, 2),
-        pair.projectorMatrix(1, 2);
+    parameters.segment<4>(6) << pair.projectorMatrix(0, 0), pair.projectorMatrix(1, 1),
+        pair.projectorMatrix(0, 2), pair.projectorMatrix(1, 2);
     parameters.segment<3>(10) = vectorFromRotation(pair.cameraToProjector.rotation());
     parameters.segment<3>(13) = pair.cameraToProjector.translation();
     for (size_t view = 0, rectangle = 0; view < views.size(); ++view) {
@@ -327,7 +373,8 @@ PlaneView thinned(const PlaneView& view, int limit) {
     return kept;
 }
 
-PairUncertainty uncertaintyOf(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals) {
+PairUncertainty uncertaintyOf(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
+                              const ParameterLayout& layout) {
     PairUncertainty uncertainty;
     const Eigen::Index degreesOfFreedom = jacobian.rows() - jacobian.cols();
     if (degreesOfFreedom <= 0)
@@ -339,8 +386,10 @@ PairUncertainty uncertaintyOf(const Eigen::MatrixXd& jacobian, const Eigen::Vect
     const Eigen::MatrixXd scaled = jacobian * scale.asDiagonal();
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
     const Eigen::VectorXd inverseSquares = svd.singularValues().cwiseAbs2().cwiseInverse();
-    const Eigen::MatrixXd covariance = variance * scale.asDiagonal() * svd.matrixV() * inverseSquares.asDiagonal() *
-                                       svd.matrixV().transpose() * scale.asDiagonal();
+    const Eigen::MatrixXd freeCovariance = variance * scale.asDiagonal() * svd.matrixV() *
+                                           inverseSquares.asDiagonal() * svd.matrixV().transpose() *
+                                           scale.asDiagonal();
+    const Eigen::MatrixXd covariance = layout.expansion() * freeCovariance * layout.expansion().transpose();
     const Eigen::VectorXd deviation = covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
     uncertainty.camera = deviation.head<4>();
     uncertainty.distortion = deviation.segment<2>(4);
@@ -398,23 +447,25 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
         parameterCount += view.rectangleCorners ? 6 : 3;
         residualTotal += residualCount(view);
     }
-    PairResiduals residuals(used, options, parameterCount, residualTotal);
+    const ParameterLayout layout(options.squarePixels, parameterCount);
+    PairResiduals residuals(used, options, layout, residualTotal);
     InitialEstimate initial = initialEstimate(used, options, parameterCount, residuals);
     if (!initial.failure.empty()) {
         calibration.message = initial.failure;
         return calibration;
     }
 
-    Eigen::VectorXd parameters = initial.parameters;
+    Eigen::VectorXd free = layout.reduce(initial.parameters);
     Eigen::LevenbergMarquardt<PairResiduals> solver(residuals);
     solver.setMaxfev(1000);
     solver.setXtol(1e-12);
     solver.setFtol(1e-12);
-    const Eigen::LevenbergMarquardtSpace::Status status = solver.minimize(parameters);
+    const Eigen::LevenbergMarquardtSpace::Status status = solver.minimize(free);
     calibration.iterations = static_cast<int>(solver.iterations());
 
+    const Eigen::VectorXd parameters = layout.expand(free);
     Eigen::VectorXd finalResiduals(residualTotal);
-    residuals(parameters, finalResiduals);
+    residuals(free, finalResiduals);
     calibration.rmsPx = reprojectionRms(used, finalResiduals);
     calibration.pair = pairFromParameters(parameters, options);
     for (size_t view = 0; view < used.size(); ++view) {
@@ -424,8 +475,8 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
                                          : planeFromInverseDepth(parameters.segment<3>(offset)));
     }
     Eigen::MatrixXd jacobian;
-    residuals.df(parameters, jacobian);
-    calibration.standardDeviation = uncertaintyOf(jacobian, finalResiduals);
+    residuals.df(free, jacobian);
+    calibration.standardDeviation = uncertaintyOf(jacobian, finalResiduals, layout);
 
     if (status == Eigen::LevenbergMarquardtSpace::ImproperInputParameters || !finalResiduals.allFinite()) {
         calibration.message = "the least squares did not run: the initial estimate is not usable";
@@ -436,27 +487,29 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
     for (size_t first = 0; first < used.size(); ++first)
         for (size_t second = first + 1; second < used.size(); ++second)
             if (used[first].rectangleCorners && used[second].rectangleCorners)
-                widestTiltDeg = std::max(widestTiltDeg, std::acos(std::clamp(calibration.planes[first].normal().dot(
-                                                                                 calibration.planes[second].normal()),
-                                                                             -1.0, 1.0)) *
-                                                            180.0 / M_PI);
+                widestTiltDeg =
+                    std::max(widestTiltDeg, std::acos(std::clamp(calibration.planes[first].normal().dot(
+                                                                     calibration.planes[second].normal()),
+                                                                 -1.0, 1.0)) *
+                                                180.0 / M_PI);
     constexpr double kMinTiltDeg = 10.0;
     if (widestTiltDeg < kMinTiltDeg) {
         char message[160];
-        std::snprintf(message, sizeof message,
-                      "the surfaces carrying the rectangle differ in tilt by %.1f degrees at most; tilt the board "
-                      "by %.0f degrees or more in different directions",
-                      widestTiltDeg, kMinTiltDeg);
+        std::snprintf(
+            message, sizeof message,
+            "the surfaces carrying the rectangle differ in tilt by %.1f degrees at most; tilt the board "
+            "by %.0f degrees or more in different directions",
+            widestTiltDeg, kMinTiltDeg);
         calibration.message = message;
         return calibration;
     }
     if (!(calibration.rmsPx.all <= options.maxRmsPx)) {
         char message[200];
-        std::snprintf(message, sizeof message,
-                      "RMS reprojection error %.2f px exceeds %.2f px (camera %.2f, projector %.2f): views of "
-                      "surfaces that are not flat, or correspondences that are wrong",
-                      calibration.rmsPx.all, options.maxRmsPx, calibration.rmsPx.camera,
-                      calibration.rmsPx.projector);
+        std::snprintf(
+            message, sizeof message,
+            "RMS reprojection error %.2f px exceeds %.2f px (camera %.2f, projector %.2f): views of "
+            "surfaces that are not flat, or correspondences that are wrong",
+            calibration.rmsPx.all, options.maxRmsPx, calibration.rmsPx.camera, calibration.rmsPx.projector);
         calibration.message = message;
         return calibration;
     }

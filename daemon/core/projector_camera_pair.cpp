@@ -28,9 +28,10 @@ Eigen::Vector2d ProjectorCameraPair::projectorPixelOf(const Eigen::Vector2d& raw
     return (projectorMatrix * point).hnormalized();
 }
 
-Eigen::Vector3d ProjectorCameraPair::planePointOfCameraPixel(const Eigen::Vector2d& rawCameraPixel,
-                                                             const Eigen::Hyperplane<double, 3>& plane) const {
-    return intersect(Eigen::Vector3d::Zero(), camera.undistortToNormalised(rawCameraPixel).homogeneous(), plane);
+Eigen::Vector3d ProjectorCameraPair::planePointOfCameraPixel(
+    const Eigen::Vector2d& rawCameraPixel, const Eigen::Hyperplane<double, 3>& plane) const {
+    return intersect(Eigen::Vector3d::Zero(), camera.undistortToNormalised(rawCameraPixel).homogeneous(),
+                     plane);
 }
 
 Calibration ProjectorCameraPair::withTable(const Eigen::Isometry3d& tableToCamera) const {

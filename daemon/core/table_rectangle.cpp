@@ -73,6 +73,33 @@ double meanLevel(const cv::Mat& gray, const std::vector<cv::Point>& outer,
     return cv::mean(gray(bounds), mask)[0];
 }
 
+// Four corners of a dark blob's outline, within a few pixels. A rectangle's outline simplifies to four
+// vertices; a lens's curvature of long sides may need a coarser simplification, and a blob whose outline does
+// not become four vertices is taken as its minimum-area box (the edge refinement sorts out whether it is a
+// rectangle).
+std::optional<Quad> roughQuad(const std::vector<cv::Point>& contour, const cv::RotatedRect& box,
+                              double shortSide) {
+    std::vector<cv::Point> polygon;
+    Quad rough;
+    for (double tolerance = 0.25; tolerance <= 0.6; tolerance *= 1.5) {
+        cv::approxPolyDP(contour, polygon, std::max(1.0, tolerance * shortSide), true);
+        if (polygon.size() < 4)
+            break;
+        if (polygon.size() == 4) {
+            if (!cv::isContourConvex(polygon))
+                return std::nullopt;
+            for (int index = 0; index < 4; ++index)
+                rough[index] = {polygon[index].x, polygon[index].y};
+            return rough;
+        }
+    }
+    std::array<cv::Point2f, 4> corners;
+    box.points(corners.data());
+    for (int index = 0; index < 4; ++index)
+        rough[index] = {corners[index].x, corners[index].y};
+    return rough;
+}
+
 // The mean side lengths of the two pairs of opposite sides.
 std::pair<double, double> oppositeSideLengths(const Quad& quad) {
     return {((quad[1] - quad[0]).norm() + (quad[3] - quad[2]).norm()) / 2.0,
@@ -158,7 +185,7 @@ struct Candidate {
     Quad corners;  // cyclic, undistorted pixels
     double edgeRmsPx = 0.0;
     double contrastDn = 0.0;
-    double aspectError = 0.0;
+    double aspectError = 0.0;  // |log| of the side ratio over the true one
 };
 
 // Labels the cyclic corners so that corner 0 -> 1 runs along a longer side towards increasing columns and the
@@ -191,8 +218,8 @@ std::optional<std::string> TableRectangleOptions::validate() const {
         return "rectangle size_mm: both sides must be positive";
     if (sizeMm.width < sizeMm.height)
         return "rectangle size_mm: give the longer side first";
-    if (!(maxAspectError > 0))
-        return "rectangle max_aspect_error: must be positive";
+    if (!(maxViewAngleDeg > 0 && maxViewAngleDeg < 90))
+        return "rectangle max_view_angle_deg: must be between 0 and 90";
     if (!(minContrastDn > 0))
         return "rectangle min_contrast_dn: must be positive";
     if (!(minSidePx >= 3))
@@ -228,6 +255,7 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
     cv::findContours(dark, contours, cv::RETR_LIST, cv::CHAIN_APPROX_NONE);
 
     const double expectedAspect = options.sizeMm.width / options.sizeMm.height;
+    const double maxAspectError = -std::log(std::cos(options.maxViewAngleDeg * M_PI / 180.0));
     std::vector<Candidate> candidates;
     for (const std::vector<cv::Point>& contour : contours) {
         if (cv::contourArea(contour) < options.minSidePx * options.minSidePx)
@@ -236,20 +264,17 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         const double shortSide = std::min(box.size.width, box.size.height);
         if (shortSide < options.minSidePx)
             continue;
-        std::vector<cv::Point> polygon;
-        cv::approxPolyDP(contour, polygon, std::max(1.0, 0.25 * shortSide), true);
-        if (polygon.size() != 4 || !cv::isContourConvex(polygon))
+        const std::optional<Quad> outline = roughQuad(contour, box, shortSide);
+        if (!outline)
             continue;
-        Quad rough;
-        for (int index = 0; index < 4; ++index)
-            rough[index] = {polygon[index].x, polygon[index].y};
+        const Quad& rough = *outline;
         const auto aspectError = [&](const Quad& quad) {
             const auto [first, second] = oppositeSideLengths(quad);
-            return std::max(first, second) / std::min(first, second) / expectedAspect - 1.0;
+            return std::abs(std::log(std::max(first, second) / std::min(first, second) / expectedAspect));
         };
         // The outline's vertices cut the corners; its bounding box gives the better first guess of the shape.
         const double boxAspect = std::max(box.size.width, box.size.height) / shortSide;
-        if (std::abs(boxAspect / expectedAspect - 1.0) > options.maxAspectError)
+        if (std::abs(std::log(boxAspect / expectedAspect)) > maxAspectError)
             continue;
 
         // Outlines of the threshold mask are a pixel or two off the real edges: search across them within a
@@ -275,7 +300,7 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         Candidate candidate;
         candidate.corners = refined->corners;
         candidate.aspectError = aspectError(candidate.corners);
-        if (std::abs(candidate.aspectError) > options.maxAspectError)
+        if (candidate.aspectError > maxAspectError)
             continue;
         candidate.edgeRmsPx = refined->edgeRmsPx;
         candidate.contrastDn = contrast;
@@ -294,9 +319,9 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         detection.message = message;
         return detection;
     }
-    const Candidate& best = *std::min_element(
-        candidates.begin(), candidates.end(),
-        [](const auto& a, const auto& b) { return std::abs(a.aspectError) < std::abs(b.aspectError); });
+    const Candidate& best =
+        *std::min_element(candidates.begin(), candidates.end(),
+                          [](const auto& a, const auto& b) { return a.aspectError < b.aspectError; });
 
     detection.corners = tableOrder(best.corners);
     const double w = options.sizeMm.width, h = options.sizeMm.height;

@@ -16,10 +16,10 @@ namespace everytouch::core {
 struct TableRectangleOptions {
     // Longer side first, mm. ISO/IEC 7811 stripe: 85.5 x 12.5 mm (it runs the card's full width).
     cv::Size2d sizeMm{85.5, 12.5};
-    // How far the rectangle's side ratio in the image may stray from the true one, relative. Perspective
-    // foreshortens one direction by the cosine of the viewing angle: 0.3 allows views up to about 45 degrees
-    // off the surface normal.
-    double maxAspectError = 0.3;
+    // Steepest view of the surface the rectangle is accepted at, degrees from the surface's normal.
+    // Perspective shortens one direction by up to the cosine of this angle, so the side ratio in the image
+    // may be that much smaller or larger than the true one.
+    double maxViewAngleDeg = 55.0;
     // The rectangle must be at least this much darker than the surface around it, digital levels. A black
     // stripe on a light table under the projector's white is about 150 DN darker.
     double minContrastDn = 20.0;

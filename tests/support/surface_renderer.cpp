@@ -23,7 +23,8 @@ double reflectance(const SurfaceScene& scene, const Eigen::Vector2d& pointMm) {
 }
 
 double projectorLevel(const cv::Mat& projectorImage, const Eigen::Vector2d& pixel) {
-    const int x = static_cast<int>(std::floor(pixel.x() + 0.5)), y = static_cast<int>(std::floor(pixel.y() + 0.5));
+    const int x = static_cast<int>(std::floor(pixel.x() + 0.5)),
+              y = static_cast<int>(std::floor(pixel.y() + 0.5));
     if (x < 0 || y < 0 || x >= projectorImage.cols || y >= projectorImage.rows)
         return 0.0;
     return projectorImage.at<uchar>(y, x) / 255.0;
@@ -69,8 +70,9 @@ cv::Mat renderSurface(const SurfaceScene& scene, const cv::Mat& projectorImage, 
                         continue;  // the ray misses the surface (looks above its horizon)
                     const Eigen::Vector2d pointMm = onSurface.hnormalized();
                     const Eigen::Vector2d projector = (rayToProjector * ray).hnormalized();
-                    sum += reflectance(scene, pointMm) *
-                           (scene.ambientDn + scene.projectorGainDn * projectorLevel(projectorImage, projector));
+                    sum +=
+                        reflectance(scene, pointMm) *
+                        (scene.ambientDn + scene.projectorGainDn * projectorLevel(projectorImage, projector));
                 }
             }
             radiance.at<double>(v, u) = sum / (supersampling * supersampling);

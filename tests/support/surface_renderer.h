@@ -10,7 +10,8 @@
 namespace everytouch::test {
 
 // A dark rectangle lying on the surface (a credit card's magnetic stripe, say), in the surface's millimetres:
-// it spans origin + a * (cos angle, sin angle) + b * (-sin angle, cos angle), a in [0, width], b in [0, height].
+// it spans origin + a * (cos angle, sin angle) + b * (-sin angle, cos angle), a in [0, width], b in [0,
+// height].
 struct DarkRectangle {
     Eigen::Vector2d originMm = Eigen::Vector2d::Zero();
     cv::Size2d sizeMm{85.5, 12.5};
@@ -18,9 +19,9 @@ struct DarkRectangle {
     double albedo = 0.08;  // a black stripe reflects a few per cent
 };
 
-// A flat light surface (the table, or a tilted board) seen by the camera and lit by the projector. The surface
-// is the plane z = 0 of the calibration's "table" frame, so a tilted board is a calibration whose table
-// transforms are the board's.
+// A flat light surface (the table, or a tilted board) seen by the camera and lit by the projector. The
+// surface is the plane z = 0 of the calibration's "table" frame, so a tilted board is a calibration whose
+// table transforms are the board's.
 struct SurfaceScene {
     core::Calibration rig;
     std::vector<DarkRectangle> rectangles;

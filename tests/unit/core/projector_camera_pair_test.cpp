@@ -17,10 +17,11 @@ TEST(ProjectorCameraPair, TransferThroughTheTableMatchesTheTableHomographies) {
     const Calibration calibration = test::paperLikeCalibration();
     const ProjectorCameraPair pair = pairOf(calibration);
     const Eigen::Hyperplane<double, 3> table = tableInCamera(calibration);
-    for (const Eigen::Vector2d& projector : {Eigen::Vector2d(10, 20), Eigen::Vector2d(320, 240),
-                                             Eigen::Vector2d(630, 470)}) {
+    for (const Eigen::Vector2d& projector :
+         {Eigen::Vector2d(10, 20), Eigen::Vector2d(320, 240), Eigen::Vector2d(630, 470)}) {
         const Eigen::Vector2d camera = pair.cameraPixelOf(projector, table);
-        EXPECT_LT((camera - applyHomography(calibration.projectorToCameraHomography(), projector)).norm(), 1e-9);
+        EXPECT_LT((camera - applyHomography(calibration.projectorToCameraHomography(), projector)).norm(),
+                  1e-9);
         EXPECT_LT((pair.projectorPixelOf(camera, table) - projector).norm(), 1e-9);
     }
 }
@@ -31,7 +32,8 @@ TEST(ProjectorCameraPair, TransferFollowsLensDistortion) {
     const ProjectorCameraPair pair = pairOf(calibration);
     const Eigen::Hyperplane<double, 3> table = tableInCamera(calibration);
     const Eigen::Vector3d point(40, 210, 0);
-    const Eigen::Vector2d projector = projectPoint(calibration.projectorMatrix, calibration.tableToProjector, point);
+    const Eigen::Vector2d projector =
+        projectPoint(calibration.projectorMatrix, calibration.tableToProjector, point);
     const Eigen::Vector2d raw = pair.camera.project(calibration.tableToCamera * point);
     EXPECT_LT((pair.cameraPixelOf(projector, table) - raw).norm(), 1e-9);
     EXPECT_LT((pair.projectorPixelOf(raw, table) - projector).norm(), 1e-9);

@@ -53,8 +53,8 @@ TEST(ProjectorChessboard, ValidateNamesTheProblem) {
 
 class ProjectedChessboard : public ::testing::TestWithParam<double> {};
 
-// The board on the table, seen through the paper-like rig: H_CP within a tenth of a pixel of the truth without
-// noise and with sigma = 2 DN of sensor noise.
+// The board on the table, seen through the paper-like rig: H_CP within a tenth of a pixel of the truth
+// without noise and with sigma = 2 DN of sensor noise.
 TEST_P(ProjectedChessboard, RecoversTheProjectorToCameraHomography) {
     const double noiseSigmaDn = GetParam();
     test::SurfaceScene scene;
@@ -83,7 +83,8 @@ TEST(ProjectorChessboard, TellsTheBoardFromItsHalfTurn) {
     // right projector pixels.
     test::SurfaceScene scene;
     scene.rig = test::paperLikeCalibration();
-    scene.rig.tableToProjector = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()) * scene.rig.tableToProjector;
+    scene.rig.tableToProjector =
+        Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()) * scene.rig.tableToProjector;
     scene.rig.projectorMatrix(0, 2) = scene.rig.projectorSize.width - 1 - scene.rig.projectorMatrix(0, 2);
     scene.rig.projectorMatrix(1, 2) = scene.rig.projectorSize.height - 1 - scene.rig.projectorMatrix(1, 2);
     const ChessboardOptions options;

@@ -28,9 +28,10 @@ cv::Mat whiteProjection(const core::Calibration& rig) {
     return cv::Mat(rig.projectorSize, CV_8UC1, cv::Scalar(255));
 }
 
-// Where the truth puts the rectangle's corners (table (0,0), (w,0), (w,h), (0,h) of the rectangle's own frame),
-// undistorted camera pixels.
-std::array<Eigen::Vector2d, 4> trueCorners(const test::SurfaceScene& scene, const test::DarkRectangle& rectangle) {
+// Where the truth puts the rectangle's corners (table (0,0), (w,0), (w,h), (0,h) of the rectangle's own
+// frame), undistorted camera pixels.
+std::array<Eigen::Vector2d, 4> trueCorners(const test::SurfaceScene& scene,
+                                           const test::DarkRectangle& rectangle) {
     const Eigen::Rotation2Dd turn(rectangle.angleRad);
     const double w = rectangle.sizeMm.width, h = rectangle.sizeMm.height;
     std::array<Eigen::Vector2d, 4> corners;
@@ -42,7 +43,8 @@ std::array<Eigen::Vector2d, 4> trueCorners(const test::SurfaceScene& scene, cons
     return corners;
 }
 
-double worstCornerError(const TableRectangleDetection& detection, const std::array<Eigen::Vector2d, 4>& truth) {
+double worstCornerError(const TableRectangleDetection& detection,
+                        const std::array<Eigen::Vector2d, 4>& truth) {
     double worst = 0;
     for (int index = 0; index < 4; ++index)
         worst = std::max(worst, (detection.corners[index] - truth[index]).norm());
