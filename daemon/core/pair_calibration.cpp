@@ -255,7 +255,7 @@ struct InitialEstimate {
 };
 
 InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairCalibrationOptions& options,
-                                int parameterCount, const PairResiduals& layout) {
+                                int parameterCount, const PairResiduals& residuals) {
     InitialEstimate estimate;
     estimate.parameters = Eigen::VectorXd::Zero(parameterCount);
 
@@ -340,7 +340,7 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
     parameters.segment<3>(10) = vectorFromRotation(pair.cameraToProjector.rotation());
     parameters.segment<3>(13) = pair.cameraToProjector.translation();
     for (size_t view = 0, rectangle = 0; view < views.size(); ++view) {
-        const int offset = layout.parameterOffset(view);
+        const int offset = residuals.parameterOffset(view);
         if (views[view].rectangleCorners) {
             const Eigen::Isometry3d& pose = rectanglePoses[rectangle++];
             parameters.segment<3>(offset) = vectorFromRotation(pose.rotation());

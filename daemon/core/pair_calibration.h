@@ -51,14 +51,13 @@ struct PairCalibration {
 // The one-time calibration of the rigid projector-camera pair, the projector being an inverse camera: camera
 // intrinsics with radial distortion (k1, k2), projector intrinsics, and the transform between them, from
 // views of a flat surface in several poses (the table, a plain board at different tilts). Each view pairs
-// camera and projector pixels on its surface; the surfaces' poses are unknown. Camera <-> projector
-// correspondences alone fix everything up to the principal points and a metric upgrade (two views of planes
-// determine a projective reconstruction only); the dark rectangle of known size supplies the metric
-// information and the scale, and must lie on at least three differently tilted surfaces (for each view it
-// lies on, its corners are part of that view). Starts from a closed-form estimate (principal point at the
-// centre, focal length from the rectangles' homographies, the projector calibrated from the surfaces so
-// found) and minimises the reprojection errors in both devices over all parameters and the surfaces' poses
-// with Levenberg-Marquardt.
+// camera and projector pixels on its surface; the surfaces' poses are unknown. Correspondences alone
+// determine only a projective reconstruction (everything up to the camera matrix and the plane at infinity);
+// the dark rectangle of known size supplies the metric information and the scale, and must lie on at least
+// three differently tilted surfaces (docs/calibration.md has the figures). Starts from a closed-form estimate
+// (principal point at the centre, focal length from the rectangles' homographies, the projector calibrated
+// from the surfaces so found) and minimises the reprojection errors in both devices over all parameters and
+// the surfaces' poses with Levenberg-Marquardt.
 PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views,
                                              const PairCalibrationOptions& options);
 

@@ -40,7 +40,7 @@ struct TableRectangleDetection {
     Eigen::Matrix3d tableToCamera = Eigen::Matrix3d::Identity();
     double edgeRmsPx = 0.0;   // scatter of the sub-pixel edge points about the four fitted lines
     double contrastDn = 0.0;  // surround minus inside
-    int candidates = 0;       // dark quadrilaterals of the right shape seen; the darkest best-shaped one wins
+    int candidates = 0;       // dark quadrilaterals of a possible shape seen; the one closest in shape wins
 };
 
 // Finds the rectangle in an 8-bit gray or BGR camera frame. Its edges are located to sub-pixel precision

@@ -80,6 +80,10 @@ void expectUndistortedMaximalDisplay(const Calibration& rig, cv::Size display) {
 
 TEST(Keystone, PaperLikeRigGetsTheLargestUndistortedDisplay) {
     expectUndistortedMaximalDisplay(test::paperLikeCalibration(), {1280, 960});
+    const Eigen::Vector2d sizeMm =
+        fitDisplayToTable(test::paperLikeCalibration(), {1280, 960}).tableRectangleMm.sizes();
+    RecordProperty("display_width_mm", std::to_string(sizeMm.x()));
+    RecordProperty("display_height_mm", std::to_string(sizeMm.y()));
 }
 
 TEST(Keystone, WideAndTallDisplaysFitToo) {

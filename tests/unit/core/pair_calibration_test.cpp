@@ -242,6 +242,8 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
     ASSERT_TRUE(tableView.failure.empty()) << tableView.failure;
     const TableSetup setup = setUpTable(found, tableView.view, {});
     ASSERT_TRUE(setup.success) << setup.message;
+    RecordProperty("table_setup_rms_px", std::to_string(setup.rmsPx.all));
+    EXPECT_LT(setup.rmsPx.all, scenario.maxRmsPx);
     const Eigen::Isometry3d rectangleToTable =
         Eigen::Translation3d(stripeInTheLight(table).originMm.x(), stripeInTheLight(table).originMm.y(), 0) *
         Eigen::Isometry3d::Identity();
