@@ -393,7 +393,7 @@ void Renderer::shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& d
 }
 
 void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box, int polarityIndex,
-                         double ambientLux, FrameTruth& truth) {
+                         double ambientLux, FrameTruth* truth) {
     if (box.area() == 0)
         return;
     depth_(box).setTo(kNoHit);
@@ -473,37 +473,23 @@ void Renderer::castHands(const std::vector<PreparedCapsule>& capsules, const cv:
             shadeHit(capsules[shadeIndex], shadeDirection, shadeT, polarityIndex, ambientLux, colour, height);
             for (int c = 0; c < 3; ++c)
                 out[3 * x + c] = coverage * colour[c] + (1.0f - coverage) * out[3 * x + c];
-            if (hit) {
-                truth.handMask.at<uchar>(y, x) = 255;
-                truth.visibleHeightMm.at<float>(y, x) = height;
+            if (hit && truth) {
+                truth->handMask.at<uchar>(y, x) = 255;
+                truth->visibleHeightMm.at<float>(y, x) = height;
             }
         }
     }
 }
 
-void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarity, double ambientLux,
-                      double exposureMs, std::uint64_t noiseSeed, cv::Mat& image, FrameTruth& truth) {
-    CV_Assert(!projected_[0].empty());
-    const int polarityIndex = polarity == core::Polarity::Positive ? 0 : 1;
+void Renderer::prepare(const std::vector<HandPose>& hands, std::vector<PreparedCapsule>& capsules,
+                       cv::Rect& cameraBox, cv::Rect& projectorBox) const {
     const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
-    truth.handMask.create(cameraSize, CV_8UC1);
-    truth.handMask.setTo(0);
-    truth.visibleHeightMm.create(cameraSize, CV_32FC1);
-    truth.visibleHeightMm.setTo(0.0f);
-    truth.fingertips.clear();
-    truth.ambientLux = ambientLux;
-    truth.exposureMs = exposureMs;
-
-    std::vector<PreparedCapsule>& capsules = capsules_;
-    capsules.clear();
-    cv::Rect cameraBox, projectorBox;
     const Eigen::Matrix3f cameraPixelToRay = cameraPixelToRay_.cast<float>();
     const Eigen::Matrix3f projectorPixelToRay = projectorPixelToRay_.cast<float>();
-    const Eigen::Matrix3d displayFromTable = calibration_.displayToTableHomography().inverse();
-    const Eigen::Matrix3d tableToCamera = calibration_.tableToCameraHomography();
-    for (size_t h = 0; h < hands.size(); ++h) {
-        const HandModel model = buildHand(hands[h]);
-        for (const HandCapsule& part : model.capsules) {
+    capsules.clear();
+    cameraBox = projectorBox = cv::Rect();
+    for (const HandPose& hand : hands)
+        for (const HandCapsule& part : buildHand(hand).capsules) {
             PreparedCapsule capsule{
                 CapsuleHit(part.shape, cameraCentre_),
                 CapsuleHit(part.shape, projectorCentre_),
@@ -520,6 +506,30 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
             projectorBox |= capsule.projectorBox;
             capsules.push_back(std::move(capsule));
         }
+}
+
+void Renderer::render(const std::vector<std::vector<HandPose>>& exposure, core::Polarity polarity,
+                      double ambientLux, double exposureMs, std::uint64_t noiseSeed, cv::Mat& image,
+                      FrameTruth& truth) {
+    CV_Assert(!projected_[0].empty() && exposure.size() % 2 == 1);
+    const int polarityIndex = polarity == core::Polarity::Positive ? 0 : 1;
+    const cv::Size cameraSize = calibration_.cameraSize;
+    const cv::Rect whole(0, 0, cameraSize.width, cameraSize.height);
+    truth.handMask.create(cameraSize, CV_8UC1);
+    truth.handMask.setTo(0);
+    truth.visibleHeightMm.create(cameraSize, CV_32FC1);
+    truth.visibleHeightMm.setTo(0.0f);
+    truth.fingertips.clear();
+    truth.ambientLux = ambientLux;
+    truth.exposureMs = exposureMs;
+
+    // The ground truth is the scene at mid-exposure, the middle instant.
+    const size_t middle = exposure.size() / 2;
+    const Eigen::Matrix3d displayFromTable = calibration_.displayToTableHomography().inverse();
+    const Eigen::Matrix3d tableToCamera = calibration_.tableToCameraHomography();
+    for (size_t h = 0; h < exposure[middle].size(); ++h) {
+        const HandPose& hand = exposure[middle][h];
+        const HandModel model = buildHand(hand);
         for (int f = 0; f < kFingerCount; ++f) {
             FingertipTruth tip;
             tip.hand = static_cast<int>(h);
@@ -528,7 +538,7 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
             tip.pad = model.pads[f];
             tip.heightMm = tip.pad.z() < kContactToleranceMm ? 0.0 : tip.pad.z();
             tip.touching = tip.heightMm == 0.0;
-            tip.presented = hands[h].presented[f];
+            tip.presented = hand.presented[f];
             const Eigen::Vector2d display = core::applyHomography(displayFromTable, tip.pad.head<2>());
             const Eigen::Vector2d camera = core::applyHomography(tableToCamera, tip.pad.head<2>());
             tip.display = {display.x(), display.y()};
@@ -536,9 +546,30 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
             truth.fingertips.push_back(tip);
         }
     }
+
+    // Hands at every instant, and the camera region they and their shadows change.
+    const int instants = static_cast<int>(exposure.size());
+    if (instantCapsules_.size() < exposure.size()) {
+        instantCapsules_.resize(exposure.size());
+        instantCameraBoxes_.resize(exposure.size());
+        instantProjectorBoxes_.resize(exposure.size());
+    }
+    const int shadowReach = static_cast<int>(std::ceil(3.0 * parameters_.projectorDefocusPx)) + 1;
+    cv::Rect changed;
+    for (int i = 0; i < instants; ++i) {
+        prepare(exposure[i], instantCapsules_[i], instantCameraBoxes_[i], instantProjectorBoxes_[i]);
+        const cv::Rect& p = instantProjectorBoxes_[i];
+        if (p.area() > 0)
+            changed |= instantCameraBoxes_[i] |
+                       shadowOnTable(cv::Rect(p.x - shadowReach, p.y - shadowReach, p.width + 2 * shadowReach,
+                                              p.height + 2 * shadowReach) &
+                                     cv::Rect(0, 0, shadowDepth_.cols, shadowDepth_.rows));
+    }
+
     // The table as precomputed, camera blur included, kept per polarity: only what the hands changed in the
     // last frame of this polarity is restored. Then, where hands and their shadows change the table, the same
-    // is computed again from the unblurred table with them, and blurred.
+    // is computed again from the unblurred table with them, averaged over the instants of the exposure
+    // (motion blur), and blurred.
     cv::Mat& frame = frameRadiance_[polarityIndex];
     cv::Rect& dirty = dirty_[polarityIndex];
     if (frame.empty() || frameAmbientLux_[polarityIndex] != ambientLux ||
@@ -551,26 +582,37 @@ void Renderer::render(const std::vector<HandPose>& hands, core::Polarity polarit
                      frame(dirty));
     }
     dirty = cv::Rect();
-    castShadows(capsules, projectorBox);
-    const cv::Rect shadowBox = shadowOnTable(shadowBox_);
-    const cv::Rect changed = cameraBox | shadowBox;
-    if (changed.area() > 0) {
-        const cv::Rect image(0, 0, cameraSize.width, cameraSize.height);
+    if (changed.area() == 0) {
+        castShadows({}, cv::Rect());  // clears the last frame's shadow map
+    } else {
         const int reach = static_cast<int>(std::ceil(3.0 * parameters_.cameraDefocusPx));
         const cv::Rect blurredPart = cv::Rect(changed.x - reach, changed.y - reach, changed.width + 2 * reach,
                                               changed.height + 2 * reach) &
-                                     image;
+                                     whole;
         const cv::Rect inputPart = cv::Rect(changed.x - 2 * reach, changed.y - 2 * reach,
                                             changed.width + 4 * reach, changed.height + 4 * reach) &
-                                   image;
+                                   whole;
         if (radiance_.empty()) {
             radiance_ = cv::Mat::zeros(cameraSize, CV_32FC3);
             partBlurred_.create(cameraSize, CV_32FC3);
+            exposed_.create(cameraSize, CV_32FC3);
         }
-        cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart),
-                     radiance_(inputPart));
-        shadeTable(shadowBox, projected_[polarityIndex]);
-        castHands(capsules, cameraBox, polarityIndex, ambientLux, truth);
+        for (int i = 0; i < instants; ++i) {
+            cv::scaleAdd(ambientTerm_(inputPart), ambientLux, projected_[polarityIndex](inputPart),
+                         radiance_(inputPart));
+            castShadows(instantCapsules_[i], instantProjectorBoxes_[i]);
+            shadeTable(shadowOnTable(shadowBox_), projected_[polarityIndex]);
+            castHands(instantCapsules_[i], instantCameraBoxes_[i], polarityIndex, ambientLux,
+                      i == static_cast<int>(middle) ? &truth : nullptr);
+            if (instants == 1)
+                break;
+            if (i == 0)
+                radiance_(inputPart).copyTo(exposed_(inputPart));
+            else
+                exposed_(inputPart) += radiance_(inputPart);
+        }
+        if (instants > 1)
+            exposed_(inputPart).convertTo(radiance_(inputPart), CV_32F, 1.0 / instants);
         cv::Mat blurred = partBlurred_(inputPart);
         blurIfNeeded(radiance_(inputPart), blurred, parameters_.cameraDefocusPx);
         partBlurred_(blurredPart).copyTo(frame(blurredPart));

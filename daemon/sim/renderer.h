@@ -53,10 +53,13 @@ public:
     // The display image (BGR 8-bit, display size): recomputes the light of both projected images.
     void setContent(const cv::Mat& displayContent);
 
-    // Renders the camera frame showing I (Positive) or I' (Negative) with the hands posed in `hands`. `image`
-    // receives the 8-bit camera image; `truth` the fingertips, mask and visible heights.
-    void render(const std::vector<HandPose>& hands, core::Polarity polarity, double ambientLux,
-                double exposureMs, std::uint64_t noiseSeed, cv::Mat& image, FrameTruth& truth);
+    // Renders the camera frame showing I (Positive) or I' (Negative). `exposure` holds the hands at an odd
+    // number of instants spread evenly over the exposure; the image averages them (motion blur) and the truth
+    // describes the middle one. `image` receives the 8-bit camera image; `truth` the fingertips, mask and
+    // visible heights.
+    void render(const std::vector<std::vector<HandPose>>& exposure, core::Polarity polarity,
+                double ambientLux, double exposureMs, std::uint64_t noiseSeed, cv::Mat& image,
+                FrameTruth& truth);
 
     // Exposure that brings white content on the table (projector white plus `ambientLux`) to the metering
     // level at the image centre, bounded by the longest allowed exposure.
@@ -78,8 +81,11 @@ private:
     // Camera region of the table that hand shadows within `projectorBox` can fall on.
     cv::Rect shadowOnTable(const cv::Rect& projectorBox) const;
     void shadeTable(const cv::Rect& cameraBox, const cv::Mat& projected);
+    // Ray casts the hands into radiance_; records mask and visible heights into `truth` when given.
     void castHands(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box, int polarityIndex,
-                   double ambientLux, FrameTruth& truth);
+                   double ambientLux, FrameTruth* truth);
+    void prepare(const std::vector<HandPose>& hands, std::vector<PreparedCapsule>& capsules,
+                 cv::Rect& cameraBox, cv::Rect& projectorBox) const;
     void shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t,
                   int polarityIndex, double ambientLux, float* bgr, float& height) const;
 
@@ -125,7 +131,9 @@ private:
     int contentVersion_ = 0;
     cv::Mat partBlurred_;     // CV_32FC3, camera size: the changed region through the camera's blur
     cv::Mat blockedOnTable_;  // CV_32FC1, camera size: shadow mask in camera pixels, in the shadow's region
-    std::vector<PreparedCapsule> capsules_;
+    cv::Mat exposed_;         // CV_32FC3, camera size: radiance summed over the instants of the exposure
+    std::vector<std::vector<PreparedCapsule>> instantCapsules_;  // per instant of the exposure
+    std::vector<cv::Rect> instantCameraBoxes_, instantProjectorBoxes_;
     cv::Mat work_[4];  // content precomputation
 };
 

@@ -252,6 +252,8 @@ const std::vector<OptionEntry>& entries() {
          number(&SimParameters::vignettingPower)},
         {{"pixel_samples", "n for n x n samples per camera pixel on the table"},
          integer(&SimParameters::pixelSamples)},
+        {{"motion_samples", "most instants per exposure for moving hands (odd; 1: no motion blur)"},
+         integer(&SimParameters::motionSamples)},
     };
     return table;
 }

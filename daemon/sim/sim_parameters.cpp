@@ -106,6 +106,8 @@ std::optional<std::string> SimParameters::validate() const {
         return "vignetting_power: must be in [0, 8]";
     if (pixelSamples < 1 || pixelSamples > 8)
         return "pixel_samples: must be in 1..8";
+    if (motionSamples < 1 || motionSamples > 15 || motionSamples % 2 == 0)
+        return "motion_samples: must be odd, 1..15";
     return std::nullopt;
 }
 

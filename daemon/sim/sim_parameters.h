@@ -97,6 +97,9 @@ struct SimParameters {
     double cameraDefocusPx = 0.5;      // Gaussian sigma of the camera's blur, camera pixels
     double vignettingPower = 3.0;      // relative illumination falls as cos(field angle)^power
     int pixelSamples = 3;  // the table image is integrated over each camera pixel with n x n samples
+    int motionSamples =
+        5;  // most instants a moving hand is rendered at within one exposure (motion blur):
+            // one per camera pixel it travels, odd; 1 renders every frame at mid-exposure only
 
     // The first problem found, naming the spec key of the faulty parameter; nothing when usable.
     std::optional<std::string> validate() const;

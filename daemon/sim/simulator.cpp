@@ -1,10 +1,12 @@
 #include "sim/simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/geometry.h"
 #include "core/pattern.h"
 #include "sim/rig_geometry.h"
 
@@ -96,14 +98,43 @@ void Simulator::showContent(const SceneState& scene) {
     shown_ = wanted;
 }
 
+double Simulator::travelMm(const SceneState& from, const SceneState& to) {
+    if (from.hands.size() != to.hands.size())
+        return 0.0;
+    double travel = 0.0;
+    for (size_t h = 0; h < from.hands.size(); ++h) {
+        travel = std::max(
+            travel,
+            (from.hands[h].wristToTable.translation() - to.hands[h].wristToTable.translation()).norm());
+        for (int f = 0; f < kFingerCount; ++f)
+            travel = std::max(travel, (fingerPad(from.hands[h], static_cast<Finger>(f)) -
+                                       fingerPad(to.hands[h], static_cast<Finger>(f)))
+                                          .norm());
+    }
+    return travel;
+}
+
 void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& truth) {
-    const double seconds = frameSeconds(index);
-    const SceneState scene = scenario_->at(seconds);
-    showContent(scene);
+    const double start = frameSeconds(index);
+    const double exposure = exposureMs_ / 1000.0;
+    // The scene at mid-exposure; hands that move are also rendered at more instants of the exposure, about
+    // one per camera pixel they travel, and the image averages them.
+    const SceneState middle = scenario_->at(start + exposure / 2.0);
+    showContent(middle);
+    int instants = 1;
+    if (parameters_.motionSamples > 1 && !middle.hands.empty()) {
+        const double pixels = 2.0 * travelMm(middle, scenario_->at(start + exposure)) / mmPerCameraPixel_;
+        instants = std::min(parameters_.motionSamples,
+                            1 + 2 * static_cast<int>(std::ceil(std::max(0.0, pixels - 1.0) / 2.0)));
+    }
+    exposureHands_.resize(instants);
+    for (int i = 0; i < instants; ++i)
+        exposureHands_[i] =
+            i == instants / 2 ? middle.hands : scenario_->at(start + (i + 0.5) / instants * exposure).hands;
     frame.index = index;
     frame.timestampUs = frameTimestampUs(index);
     frame.polarity = framePolarity(index);
-    renderer_->render(scene.hands, frame.polarity, ambientLux(seconds), exposureMs_,
+    renderer_->render(exposureHands_, frame.polarity, ambientLux(start + exposure / 2.0), exposureMs_,
                       mix(parameters_.seed ^ mix(index)), frame.image, truth);
 }
 

@@ -46,11 +46,14 @@ public:
     // Room light on the table at `seconds`.
     double ambientLux(double seconds) const;
 
-    // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`.
+    // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`. The frame's
+    // timestamp is the start of its exposure; the truth describes the scene at mid-exposure.
     void render(std::uint64_t index, core::Frame& frame, FrameTruth& truth);
 
 private:
     void showContent(const SceneState& scene);
+    // Largest distance a wrist or fingertip moves between two scenes, mm.
+    static double travelMm(const SceneState& from, const SceneState& to);
 
     SimParameters parameters_;
     core::Calibration calibration_;
@@ -61,6 +64,8 @@ private:
     bool fixedImage_ = false;               // content from an image
     std::optional<std::pair<ContentKind, int>> shown_;
     double exposureMs_ = 0.0;
+    double mmPerCameraPixel_ = 1.0;  // on the table at the image centre
+    std::vector<std::vector<HandPose>> exposureHands_;
 };
 
 }  // namespace everytouch::sim

@@ -102,8 +102,8 @@ protected:
         const double exposure = renderer.meterExposureMs(p.ambientLux);
         cv::Mat positive, negative;
         FrameTruth truth, unused;
-        renderer.render({pose}, core::Polarity::Positive, p.ambientLux, exposure, 11, positive, truth);
-        renderer.render({pose}, core::Polarity::Negative, p.ambientLux, exposure, 12, negative, unused);
+        renderer.render({{pose}}, core::Polarity::Positive, p.ambientLux, exposure, 11, positive, truth);
+        renderer.render({{pose}}, core::Polarity::Negative, p.ambientLux, exposure, 12, negative, unused);
         EXPECT_TRUE(truth.fingertips[1].touching);
 
         // Points on the back of the index finger's last bone, from its middle towards its tip.
@@ -160,8 +160,10 @@ TEST(CodeOnTheTable, MatchesTheTableHomographyAndNotTenMillimetresUp) {
     const double exposure = renderer.meterExposureMs(p.ambientLux);
     cv::Mat positive, negative;
     FrameTruth truth;
-    renderer.render({}, core::Polarity::Positive, p.ambientLux, exposure, 1, positive, truth);
-    renderer.render({}, core::Polarity::Negative, p.ambientLux, exposure, 2, negative, truth);
+    renderer.render(std::vector<std::vector<HandPose>>(1), core::Polarity::Positive, p.ambientLux, exposure,
+                    1, positive, truth);
+    renderer.render(std::vector<std::vector<HandPose>>(1), core::Polarity::Negative, p.ambientLux, exposure,
+                    2, negative, truth);
     const cv::Mat s = subtraction(positive, negative);
     double onTable = 0.0, raised = 0.0;
     int windows = 0;

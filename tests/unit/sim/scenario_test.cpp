@@ -146,6 +146,38 @@ TEST(Simulator, FramesAreAPureFunctionOfParametersSeedAndTime) {
     EXPECT_GT(cv::norm(a.image, c.image, cv::NORM_L1) / a.image.total(), 1.0);
 }
 
+TEST(Simulator, MovingHandsAreBlurredOverTheExposureStillOnesAreNot) {
+    SimParameters p;
+    p.scenario = "grid35";
+    p.seed = 6;
+    const cv::Mat pattern = randomPattern(p.projectorSize, 6);
+    Simulator blurred(p, pattern);
+    p.motionSamples = 1;
+    Simulator sharp(p, pattern);
+    int moving = 0, still = 0;
+    core::Frame a, b;
+    FrameTruth truthA, truthB;
+    // The first taps: the hand comes in, travels between circles, and rests on them. Noise depends only on
+    // the seed and the frame, so any difference is motion blur.
+    for (std::uint64_t index = 120; index < 600; index += 7) {
+        blurred.render(index, a, truthA);
+        sharp.render(index, b, truthB);
+        EXPECT_EQ(cv::norm(truthA.handMask, truthB.handMask, cv::NORM_INF), 0.0);
+        ASSERT_EQ(truthA.fingertips.size(), truthB.fingertips.size());
+        EXPECT_EQ(truthA.fingertips[1].pad, truthB.fingertips[1].pad);
+        const double difference = cv::norm(a.image, b.image, cv::NORM_L1);
+        if (difference == 0.0) {
+            ++still;
+        } else {
+            ++moving;
+            EXPECT_FALSE(truthA.fingertips[1].touching) << "a touching finger rests during the exposure";
+        }
+    }
+    // Only the fastest moves between circles travel more than a pixel in one exposure.
+    EXPECT_GT(moving, 0);
+    EXPECT_GT(still, 10 * moving);
+}
+
 TEST(Simulator, AmbientLightChangesMidSession) {
     SimParameters p;
     p.scenario = "idle";
