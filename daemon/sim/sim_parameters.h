@@ -44,8 +44,8 @@ struct SimParameters {
     Eigen::Vector3d cameraTarget{0.0, 10.0, 0.0};          // table point on the optical axis
     cv::Size projectorSize{640, 480};                      // DLP panel, pixels
     double projectorFocalPx = 950.0;                       // focal length, panel pixels (throw ratio ~1.5)
-    double projectorPrincipalRowPx = 150.0;  // principal point row: below 240 the lens throws the image away
-                                             // from the rig (offset lens), as projectors do
+    double projectorPrincipalRowPx = 150.0;  // principal point row: projectors' lenses are offset, so the
+                                             // image lies off the optical axis (239.5 would centre it)
     Eigen::Vector3d projectorPosition{25.0, -210.0, 460.0};  // optical centre, table mm
     Eigen::Vector3d projectorTarget{0.0, 0.0, 0.0};          // table point hit by the panel's centre pixel
     cv::Size displaySize{640, 480};                          // the desktop image, pixels
