@@ -6,8 +6,7 @@
 namespace everytouch::core {
 namespace {
 
-TEST(Embedding, DifferenceIsTwiceDeltaOnOnesAndZeroElsewhereEvenOnBlackAndWhite)
-{
+TEST(Embedding, DifferenceIsTwiceDeltaOnOnesAndZeroElsewhereEvenOnBlackAndWhite) {
     cv::Mat content(48, 64, CV_8UC3);
     content.colRange(0, 16).setTo(cv::Scalar::all(0));
     content.colRange(16, 32).setTo(cv::Scalar::all(255));
@@ -27,8 +26,7 @@ TEST(Embedding, DifferenceIsTwiceDeltaOnOnesAndZeroElsewhereEvenOnBlackAndWhite)
                     << "at " << x << "," << y;
 }
 
-TEST(Embedding, AverageIsTheContentCompressedIntoTheCodeFreeRange)
-{
+TEST(Embedding, AverageIsTheContentCompressedIntoTheCodeFreeRange) {
     cv::Mat content(1, 256, CV_8UC1);
     for (int level = 0; level < 256; ++level)
         content.at<uchar>(level) = static_cast<uchar>(level);
