@@ -12,7 +12,7 @@
 int main(int argc, char** argv) {
     using namespace everytouch;
     // Before any thread starts, so that every thread leaves these signals to the event loop.
-    service::Daemon::blockSignals();
+    service::Daemon::prepareSignals();
 
     service::DaemonOptions options;
     CLI::App app{

@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <mutex>
@@ -71,12 +72,13 @@ Daemon::~Daemon() {
     shutDown();
 }
 
-void Daemon::blockSignals() {
+void Daemon::prepareSignals() {
     sigset_t signals;
     sigemptyset(&signals);
     for (int signal : {SIGTERM, SIGINT, SIGHUP})
         sigaddset(&signals, signal);
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::signal(SIGPIPE, SIG_IGN);
 }
 
 int Daemon::run() {
@@ -323,8 +325,12 @@ void Daemon::setTouchHeightMm(double heightMm) {
                                                       formatDouble("%g", kMinTouchHeightMm) + " to " +
                                                       formatDouble("%g", kMaxTouchHeightMm) + " mm, not " +
                                                       formatDouble("%g", heightMm));
+    if (heightMm == touchHeightMm_)
+        return;
     touchHeightMm_ = heightMm;
     applySettings();
+    if (bus_)
+        bus_->propertiesChanged({"TouchHeightMm"});
     ET_LOG(Info) << "touch height set to " << heightMm << " mm";
 }
 
@@ -431,15 +437,13 @@ void Daemon::reloadConfig() {
     try {
         fresh = loadConfig(options_.configPath, options_.configPath != kDefaultConfigPath);
     } catch (const std::exception& error) {
-        throw BusError(bus::kErrorInvalidConfig,
-                       std::string(error.what()) + "; the running configuration stays in effect");
+        const std::string problem = std::string(error.what()) + "; the running configuration stays in effect";
+        ET_LOG(Error) << problem;
+        throw BusError(bus::kErrorInvalidConfig, problem);
     }
-    if (fresh.touchHeightMm != config_.touchHeightMm) {
-        touchHeightMm_ = fresh.touchHeightMm;
-        applySettings();
-        if (bus_)
-            bus_->propertiesChanged({"TouchHeightMm"});
-    }
+    // Only what the files changed is applied, so a reload keeps a touch height set over the bus.
+    if (fresh.touchHeightMm != config_.touchHeightMm)
+        setTouchHeightMm(fresh.touchHeightMm);
     const std::pair<bool, const char*> restartOnly[] = {
         {options_.rig.empty() && fresh.rig != config_.rig, "[Camera] Rig"},
         {fresh.uinput != config_.uinput, "[Output] Uinput"},
@@ -552,8 +556,10 @@ int Daemon::onStopSignal(sd_event_source* source, const struct signalfd_siginfo*
 int Daemon::onReloadSignal(sd_event_source*, const struct signalfd_siginfo*, void* userdata) noexcept {
     try {
         static_cast<Daemon*>(userdata)->reloadConfig();
+    } catch (const BusError&) {
+        // reloadConfig() has logged why the files were rejected.
     } catch (const std::exception& error) {
-        ET_LOG(Error) << error.what();
+        ET_LOG(Error) << "internal error: " << error.what();
     }
     return 0;
 }

@@ -65,8 +65,9 @@ public:
     Daemon& operator=(const Daemon&) = delete;
 
     // Blocks SIGTERM, SIGINT and SIGHUP for this thread and every thread started after it, so that sd-event
-    // receives them. Call first thing in main().
-    static void blockSignals();
+    // receives them, and ignores SIGPIPE: a client that closes its end of a Snapshot descriptor must not kill
+    // the daemon. Call first thing in main().
+    static void prepareSignals();
 
     // Runs until SIGTERM or SIGINT, the end of the stream or a failure and returns the exit status. Throws
     // io::InputError for bad options, configuration or rig (exit status kExitBadInput).

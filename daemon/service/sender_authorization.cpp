@@ -18,7 +18,8 @@ SenderAuthorization::SenderAuthorization(const std::string& groupName) : groupNa
 
 int SenderAuthorization::check(sd_bus_message* message) const {
     sd_bus_creds* raw = nullptr;
-    int r = sd_bus_query_sender_creds(message, SD_BUS_CREDS_EUID | SD_BUS_CREDS_SUPPLEMENTARY_GIDS, &raw);
+    int r = sd_bus_query_sender_creds(
+        message, SD_BUS_CREDS_EUID | SD_BUS_CREDS_SUPPLEMENTARY_GIDS | SD_BUS_CREDS_AUGMENT, &raw);
     const io::BusCreds creds(raw);
     if (r < 0)
         return r;

@@ -4,7 +4,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/pidfd.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -50,7 +50,8 @@ BackgroundProcess::BackgroundProcess(const std::vector<std::string>& argv,
     posix_spawn_file_actions_destroy(&actions);
     if (spawned != 0)
         throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(spawned));
-    pidFd_ = ::pidfd_open(pid_, 0);
+    // glibc 2.36 declares pidfd_open without C linkage for C++; the system call itself is fine.
+    pidFd_ = static_cast<int>(::syscall(SYS_pidfd_open, pid_, 0));
 }
 
 BackgroundProcess::~BackgroundProcess() {

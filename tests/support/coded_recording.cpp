@@ -9,8 +9,8 @@ namespace everytouch::test {
 
 io::RigDescription smallRig() {
     io::RigDescription rig = paperLikeRig();
-    rig.calibration.cameraSize = {324, 244};
-    rig.calibration.cameraMatrix.topRows(2) *= 0.5;
+    rig.calibration.cameraSize = {162, 122};
+    rig.calibration.cameraMatrix.topRows(2) *= 0.25;
     return rig;
 }
 

@@ -9,7 +9,7 @@
 
 namespace everytouch::test {
 
-// A small rig (camera 324x244) for tests that need many frames quickly.
+// A small rig (camera 162x122) for tests that need many frames quickly.
 io::RigDescription smallRig();
 
 // The two camera images a recording made by writeCodedRecording alternates: a gray table showing a random

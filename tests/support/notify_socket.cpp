@@ -5,6 +5,7 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -46,7 +47,7 @@ bool NotifySocket::waitFor(const std::string& line, std::chrono::milliseconds ti
         const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
             deadline - std::chrono::steady_clock::now());
         pollfd readable{fd_, POLLIN, 0};
-        if (left.count() <= 0 || ::poll(&readable, 1, static_cast<int>(left.count())) <= 0)
+        if (::poll(&readable, 1, static_cast<int>(std::max<long>(left.count(), 0))) <= 0)
             return false;
         char buffer[4096];
         const ssize_t n = ::recv(fd_, buffer, sizeof buffer, 0);
