@@ -198,6 +198,13 @@ void parseFile(const std::filesystem::path& path, DaemonConfig& config) {
 
 }  // namespace
 
+std::vector<std::pair<std::string, std::string>> configKeys() {
+    std::vector<std::pair<std::string, std::string>> keys;
+    for (const KeySpec& spec : keySpecs())
+        keys.emplace_back(spec.section, spec.key);
+    return keys;
+}
+
 std::filesystem::path dropInDirectory(const std::filesystem::path& mainFile) {
     return mainFile.string() + ".d";
 }

@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace everytouch::service {
 
@@ -27,6 +29,9 @@ struct DaemonConfig {
 // unless `mustExist`. Throws io::InputError "FILE:LINE: [Section] Key: problem" for the first unknown key,
 // bad value or malformed line.
 DaemonConfig loadConfig(const std::filesystem::path& mainFile, bool mustExist);
+
+// Every key the configuration file knows: section and key.
+std::vector<std::pair<std::string, std::string>> configKeys();
 
 // The drop-in directory of a main configuration file.
 std::filesystem::path dropInDirectory(const std::filesystem::path& mainFile);

@@ -43,7 +43,8 @@ using ::testing::Not;
 constexpr auto kStartTimeout = 60s;
 constexpr auto kExitTimeout = 30s;
 
-const std::vector<std::string> kNobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--clear-groups"};
+const std::vector<std::string> kNobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                          "--clear-groups"};
 
 std::vector<std::string> concat(std::vector<std::string> first, const std::vector<std::string>& second) {
     first.insert(first.end(), second.begin(), second.end());
@@ -120,7 +121,8 @@ protected:
     void startDaemon(const std::vector<std::string>& extra = {},
                      const std::vector<std::pair<std::string, std::string>>& environment = {}) {
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
-        std::vector<std::pair<std::string, std::string>> variables = {{"NOTIFY_SOCKET", notify_->path().string()}};
+        std::vector<std::pair<std::string, std::string>> variables = {
+            {"NOTIFY_SOCKET", notify_->path().string()}};
         variables.insert(variables.end(), environment.begin(), environment.end());
         daemon_ = std::make_unique<test::BackgroundProcess>(
             concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig",
@@ -167,8 +169,8 @@ TEST_F(ServiceTest, PropertiesAreReadableByEveryone) {
     startDaemon();
     for (const std::vector<std::string>& prefix : {std::vector<std::string>{}, kNobody}) {
         const test::ProcessResult result = test::runProcess(concat(
-            prefix, busctl({"get-property", bus::kBusName, bus::kObjectPath, bus::kInterface, "APIVersion", "State",
-                            "Rig", "Calibrated", "TouchHeightMm", "DevicePath"})));
+            prefix, busctl({"get-property", bus::kBusName, bus::kObjectPath, bus::kInterface, "APIVersion",
+                            "State", "Rig", "Calibrated", "TouchHeightMm", "DevicePath"})));
         ASSERT_EQ(result.exitCode, 0) << result.err;
         EXPECT_EQ(result.out, "u 1\ns \"running\"\ns \"replay:" + SharedRecording::path().string() +
                                   "\"\nb true\nd 3\ns \"\"\n");
@@ -194,15 +196,16 @@ TEST_F(ServiceTest, StatisticsFollowTheCamera) {
 
 TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
     startDaemon();
-    const test::ProcessResult result = test::runProcess(
-        busctl({"call", bus::kBusName, bus::kObjectPath, "org.freedesktop.DBus.Introspectable", "Introspect"}));
+    const test::ProcessResult result = test::runProcess(busctl(
+        {"call", bus::kBusName, bus::kObjectPath, "org.freedesktop.DBus.Introspectable", "Introspect"}));
     ASSERT_EQ(result.exitCode, 0) << result.err;
-    for (const char* expected :
-         {R"(<method name=\"Calibrate\">\n   <arg type=\"s\" name=\"step\" direction=\"in\"/>\n   <arg type=\"a{sv}\" name=\"options\" direction=\"in\"/>)",
-          R"(<arg type=\"h\" name=\"fd\" direction=\"in\"/>)", R"(<arg type=\"a(uddbd)\" name=\"contacts\"/>)",
-          R"(<arg type=\"d\" name=\"rms_px\"/>)",
-          R"(<property name=\"FrameRate\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
-          R"(<property name=\"TouchHeightMm\" type=\"d\" access=\"readwrite\">)"})
+    for (
+        const char* expected :
+        {R"(<method name=\"Calibrate\">\n   <arg type=\"s\" name=\"step\" direction=\"in\"/>\n   <arg type=\"a{sv}\" name=\"options\" direction=\"in\"/>)",
+         R"(<arg type=\"h\" name=\"fd\" direction=\"in\"/>)", R"(<arg type=\"a(uddbd)\" name=\"contacts\"/>)",
+         R"(<arg type=\"d\" name=\"rms_px\"/>)",
+         R"(<property name=\"FrameRate\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
+         R"(<property name=\"TouchHeightMm\" type=\"d\" access=\"readwrite\">)"})
         EXPECT_THAT(result.out, HasSubstr(expected));
 }
 
@@ -273,11 +276,14 @@ TEST_F(ServiceTest, SensitivityCommandSetsAndShowsTheTouchHeight) {
 TEST_F(ServiceTest, CalibrateRejectsBadArgumentsWithoutChangingState) {
     startDaemon();
     const std::pair<std::vector<std::string>, const char*> cases[] = {
-        {{"sa{sv}", "everything", "0"}, "Unknown calibration step \"everything\"; expected projector, table or full"},
-        {{"sa{sv}", "full", "1", "frames", "s", "many"}, "Calibrate option \"frames\" must be of type u, not s"},
+        {{"sa{sv}", "everything", "0"},
+         "Unknown calibration step \"everything\"; expected projector, table or full"},
+        {{"sa{sv}", "full", "1", "frames", "s", "many"},
+         "Calibrate option \"frames\" must be of type u, not s"},
         {{"sa{sv}", "full", "1", "frames", "u", "0"}, "Calibrate option frames: must be from 1 to 120"},
         {{"sa{sv}", "full", "1", "colour", "u", "1"}, "Unknown Calibrate option \"colour\""},
-        {{"s", "full"}, "Invalid arguments 's' to call org.everytouch.Daemon1.Calibrate(), expecting 'sa{sv}'"},
+        {{"s", "full"},
+         "Invalid arguments 's' to call org.everytouch.Daemon1.Calibrate(), expecting 'sa{sv}'"},
         {{"su", "full", "3"}, "Invalid arguments 'su' to call"},
     };
     for (const auto& [arguments, expected] : cases) {
@@ -294,8 +300,9 @@ TEST_F(ServiceTest, CalibrateFailsClearlyWhileItsEstimatorsAreMissing) {
     startDaemon();
     const test::ProcessResult direct = test::runProcess(concat(call("Calibrate"), {"sa{sv}", "table", "0"}));
     EXPECT_NE(direct.exitCode, 0);
-    EXPECT_THAT(direct.err, HasSubstr("The table step (a card of known size lying on the table (H_TC)) is not part "
-                                      "of this build yet; the current calibration stays active"));
+    EXPECT_THAT(direct.err,
+                HasSubstr("The table step (a card of known size lying on the table (H_TC)) is not part "
+                          "of this build yet; the current calibration stays active"));
     const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "projector"});
     EXPECT_EQ(tool.exitCode, 1);
     EXPECT_THAT(tool.err, HasSubstr("Calibration failed: The projector step"));
@@ -317,9 +324,11 @@ TEST_F(ServiceTest, AnUnprivilegedCallerCanReadButNotChangeAnything) {
         EXPECT_NE(result.exitCode, 0) << change[5];
         EXPECT_THAT(result.err, HasSubstr("Access denied")) << change[5];
     }
-    const test::ProcessResult tool = test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "sensitivity", "5"}));
+    const test::ProcessResult tool =
+        test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "sensitivity", "5"}));
     EXPECT_EQ(tool.exitCode, 4);
-    EXPECT_THAT(tool.err, HasSubstr("Setting the touch height needs root or membership in the \"everytouch\" group"));
+    EXPECT_THAT(tool.err,
+                HasSubstr("Setting the touch height needs root or membership in the \"everytouch\" group"));
     EXPECT_EQ(get("TouchHeightMm"), "d 3\n");
     EXPECT_EQ(get("Calibrated"), "b true\n");
     const test::ProcessResult snapshot =
@@ -498,7 +507,8 @@ TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
     startDaemon();
     const std::vector<std::string> member = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
                                              "--groups=" + std::to_string(*privilegedGroup)};
-    test::ProcessResult result = test::runProcess(concat(member, {EVERYTOUCH_CALIB_PATH, "sensitivity", "6"}));
+    test::ProcessResult result =
+        test::runProcess(concat(member, {EVERYTOUCH_CALIB_PATH, "sensitivity", "6"}));
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("TouchHeightMm"), "d 6\n");
     result = test::runProcess(concat(member, call("Calibrate", {"sa{sv}", "full", "0"})));
@@ -520,7 +530,8 @@ protected:
 
 TEST_F(DaemonOwnChecksTest, CallersNeitherRootNorInTheGroupAreRefused) {
     startDaemon();
-    // dbus-send prints the daemon's own error message (busctl shortens every AccessDenied to "Access denied").
+    // dbus-send prints the daemon's own error message (busctl shortens every AccessDenied to "Access
+    // denied").
     const auto dbusSend = [](const std::string& member, const std::vector<std::string>& arguments) {
         return concat(concat(kNobody, {"/usr/bin/dbus-send", "--system", "--print-reply",
                                        std::string("--dest=") + bus::kBusName, bus::kObjectPath, member}),
@@ -545,8 +556,8 @@ TEST_F(DaemonOwnChecksTest, CallersNeitherRootNorInTheGroupAreRefused) {
     EXPECT_EQ(calibrate.exitCode, 4) << calibrate.err;
     std::filesystem::create_directory(dir_ / "public");
     std::filesystem::permissions(dir_ / "public", std::filesystem::perms::all);
-    const test::ProcessResult snapshot = test::runProcess(
-        concat(kNobody, {EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "public" / "camera.png").string()}));
+    const test::ProcessResult snapshot = test::runProcess(concat(
+        kNobody, {EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "public" / "camera.png").string()}));
     EXPECT_EQ(snapshot.exitCode, 4) << snapshot.err;
     EXPECT_FALSE(std::filesystem::exists(dir_ / "public" / "camera.png"));
     EXPECT_EQ(get("TouchHeightMm"), "d 3\n");
@@ -557,9 +568,10 @@ TEST_F(DaemonOwnChecksTest, GroupMembersAreLetIn) {
     if (!privilegedGroup)
         GTEST_SKIP() << "cannot provide the \"everytouch\" group: " << privilegedGroupProblem;
     startDaemon();
-    const test::ProcessResult result = test::runProcess(
-        concat({"/usr/bin/setpriv", "--reuid=65534", "--regid=65534", "--groups=" + std::to_string(*privilegedGroup)},
-               concat(property("set-property", "TouchHeightMm"), {"d", "8"})));
+    const test::ProcessResult result =
+        test::runProcess(concat({"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                 "--groups=" + std::to_string(*privilegedGroup)},
+                                concat(property("set-property", "TouchHeightMm"), {"d", "8"})));
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("TouchHeightMm"), "d 8\n");
 }
@@ -572,7 +584,8 @@ TEST(EverytouchdConfig, ErrorsAtStartNameFileLineAndKey) {
     test::ProcessResult result =
         test::runProcess({EVERYTOUCHD_PATH, "--config", (dir / "everytouchd.conf").string()});
     EXPECT_EQ(result.exitCode, 2);
-    EXPECT_THAT(result.err, HasSubstr("everytouchd.conf:5: [Touch] HeightMm: must be from 0 to 30 mm, found 40"));
+    EXPECT_THAT(result.err,
+                HasSubstr("everytouchd.conf:5: [Touch] HeightMm: must be from 0 to 30 mm, found 40"));
 
     std::ofstream(dir / "everytouchd.conf") << "[Touch]\nHeightMm=4\n";
     std::filesystem::create_directory(dir / "everytouchd.conf.d");
@@ -590,8 +603,9 @@ TEST(EverytouchdService, WithoutACameraSaysSoAndExits) {
     test::TempDir dir;
     std::ofstream(dir / "everytouchd.conf") << "[Touch]\nHeightMm=4\n";
     test::NotifySocket notify(dir / "notify.socket");
-    test::BackgroundProcess daemon({EVERYTOUCHD_PATH, "--service", "--config", (dir / "everytouchd.conf").string()},
-                                   dir / "log", {{"NOTIFY_SOCKET", notify.path().string()}});
+    test::BackgroundProcess daemon(
+        {EVERYTOUCHD_PATH, "--service", "--config", (dir / "everytouchd.conf").string()}, dir / "log",
+        {{"NOTIFY_SOCKET", notify.path().string()}});
     EXPECT_EQ(daemon.waitExit(kExitTimeout), 6);
     EXPECT_TRUE(notify.waitFor("STATUS=No camera configured: set [Camera] Rig= in " +
                                    (dir / "everytouchd.conf").string() + " (see everytouchd(8))",
