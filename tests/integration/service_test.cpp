@@ -515,6 +515,28 @@ TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
     EXPECT_THAT(result.err, HasSubstr("is not part of this build yet"));
 }
 
+TEST_F(ServiceTest, TheToolSaysWhenTheDaemonIsNotRunning) {
+    for (const std::vector<std::string>& command : {std::vector<std::string>{EVERYTOUCH_CALIB_PATH, "status"},
+                                                    {EVERYTOUCH_CALIB_PATH, "sensitivity", "4"}}) {
+        const test::ProcessResult result = test::runProcess(command);
+        EXPECT_EQ(result.exitCode, 3);
+        EXPECT_THAT(result.err, HasSubstr("everytouchd is not running"));
+    }
+}
+
+TEST_F(ServiceTest, TheToolPassesCalibrationOptionsOn) {
+    startDaemon();
+    test::ProcessResult result =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--card-width-mm", "-3"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Calibrate option card_width_mm: must be more than 0"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "500"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Calibrate option frames: must be from 1 to 120"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "sideways"});
+    EXPECT_EQ(result.exitCode, 2);
+}
+
 // The same daemon behind a bus that lets anyone call anything: its own credential checks must hold.
 class DaemonOwnChecksTest : public ServiceTest {
 protected:
