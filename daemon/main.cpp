@@ -25,6 +25,10 @@ int main(int argc, char** argv) {
                    "Frame source: sim[:SCENARIO][,key=value...], replay:DIR, aravis[:ID] or v4l2:/dev/videoN "
                    "(default: [Camera] Rig= of the configuration, else sim:demo unless --service)");
     app.add_option("--log", options.touchLog, "Write the touch log (JSON Lines) to FILE; - for stdout");
+    app.add_option(
+           "--output", options.outputs,
+           "Send contacts to OUTPUT too: uinput (the virtual touchscreen; overrides [Output] Uinput=)")
+        ->delimiter(',');
     app.add_option("--record", options.recordDir, "Record every frame into the new directory DIR");
     app.add_option("--frames", options.maxFrames, "Stop after N camera frames (0: run until the rig ends)");
     app.add_flag("--fast", options.fast, "Do not pace sim and replay rigs in real time");

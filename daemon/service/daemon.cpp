@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <systemd/sd-daemon.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
@@ -98,10 +99,6 @@ int Daemon::run() {
     const io::RigSpec spec = io::RigSpec::parse(rigText);
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
-    if (config_.uinput.value_or(cameraRig_))
-        throw io::InputError(options_.configPath.string(), "[Output] Uinput",
-                             "the virtual touchscreen is not part of this build yet; set Uinput=no");
-
     source_ = openFrameSource(spec, options_.fast);
     ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe();
     const std::optional<io::RigDescription> rig = source_->rig();
@@ -140,14 +137,41 @@ int Daemon::run() {
         throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
     connectBus();
 
+    const bool uinputAsked = std::ranges::find(options_.outputs, "uinput") != options_.outputs.end();
+    if (uinputAsked || config_.uinput.value_or(cameraRig_)) {
+        touchscreen_ = std::make_unique<TouchscreenOutput>([this](const std::string& devnode) {
+            inbox_.post([this, devnode] {
+                devicePath_ = devnode;
+                if (bus_)
+                    bus_->propertiesChanged({"DevicePath"});
+            });
+        });
+        if (store_->active())
+            touchscreen_->applyCalibration(*store_->active());
+        else
+            ET_LOG(Notice)
+                << "the virtual touchscreen appears once everytouchd is calibrated: its size comes from "
+                   "the calibration";
+        sinks.push_back(touchscreen_.get());
+    }
+
     LoopOptions loopOptions;
     loopOptions.maxFrames = options_.maxFrames;
     loopOptions.queueCapacity = kQueueFrames;
     // Sim and replay running fast can wait for the pipeline; a paced stream behaves like a camera.
     loopOptions.overflow = options_.fast ? FrameQueue::Overflow::Block : FrameQueue::Overflow::DropOldest;
-    loop_ = std::make_unique<FrameLoop>(*source_, std::move(sinks), recorder_.get(), loopOptions,
-                                        PipelineSettings{store_->active(), touchHeightMm_},
-                                        [this] { inbox_.post([this] { onLoopNews(); }); });
+    loop_ = std::make_unique<FrameLoop>(
+        *source_, std::move(sinks), recorder_.get(), loopOptions,
+        PipelineSettings{store_->active(), touchHeightMm_}, [this] { inbox_.post([this] { onLoopNews(); }); },
+        [this](const PipelineSettings& settings) {
+            if (!touchscreen_ || !settings.calibration)
+                return;
+            try {
+                touchscreen_->applyCalibration(*settings.calibration);
+            } catch (const std::exception& error) {
+                ET_LOG(Error) << "virtual touchscreen: " << error.what() << "; it keeps its previous size";
+            }
+        });
     loop_->start();
     startWatchdog();
 

@@ -25,6 +25,7 @@
 #include "service/frame_loop.h"
 #include "service/main_loop_inbox.h"
 #include "service/snapshot.h"
+#include "service/touchscreen_output.h"
 
 namespace everytouch::service {
 
@@ -139,6 +140,7 @@ private:
     std::unique_ptr<io::RecordingWriter> recorder_;
     std::unique_ptr<io::ConsoleSink> console_;
     std::unique_ptr<io::TouchLogWriter> touchLog_;
+    std::unique_ptr<TouchscreenOutput> touchscreen_;
     std::optional<CalibrationStore> store_;
 
     io::Event event_;

@@ -12,6 +12,9 @@ std::optional<std::string> DaemonOptions::validate() const {
     } catch (const io::InputError& error) {
         return error.what();
     }
+    for (const std::string& output : outputs)
+        if (output != "uinput")
+            return "--output " + output + ": unknown output; the choice is uinput";
     if (!recordDir.empty() && std::filesystem::exists(recordDir) && !std::filesystem::is_empty(recordDir))
         return "--record " + recordDir.string() +
                ": exists and is not empty; choose a new recording directory";

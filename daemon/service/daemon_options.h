@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #ifndef EVERYTOUCH_SYSCONFDIR
 #define EVERYTOUCH_SYSCONFDIR "/etc"
@@ -19,12 +20,13 @@ inline constexpr const char* kHandRunRig = "sim:demo";
 struct DaemonOptions {
     std::filesystem::path configPath = kDefaultConfigPath;  // --config
     std::string rig;  // --rig: sim[:scenario], replay:DIR, aravis[:ID], v4l2:/dev/videoN; empty: the config's
-    std::filesystem::path touchLog;   // --log: JSON Lines touch log ("-" for stdout); empty for none
-    std::filesystem::path recordDir;  // --record: write every frame (and ground truth) as a recording
-    std::uint64_t maxFrames = 0;      // --frames: stop after this many camera frames; 0 runs until the end
-    bool fast = false;                // --fast: no real-time pacing for sim and replay rigs
-    bool verbose = false;             // --verbose: debug logging, every contact change on stderr
-    bool service = false;             // --service: run as the system service (no simulated fallback rig)
+    std::filesystem::path touchLog;    // --log: JSON Lines touch log ("-" for stdout); empty for none
+    std::vector<std::string> outputs;  // --output: "uinput" creates the virtual touchscreen
+    std::filesystem::path recordDir;   // --record: write every frame (and ground truth) as a recording
+    std::uint64_t maxFrames = 0;       // --frames: stop after this many camera frames; 0 runs until the end
+    bool fast = false;                 // --fast: no real-time pacing for sim and replay rigs
+    bool verbose = false;              // --verbose: debug logging, every contact change on stderr
+    bool service = false;              // --service: run as the system service (no simulated fallback rig)
 
     // The first problem found, naming the option; nothing when the options are usable.
     std::optional<std::string> validate() const;

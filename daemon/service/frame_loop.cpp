@@ -23,12 +23,13 @@ double smoothingWeight(double elapsedS) {
 
 FrameLoop::FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks,
                      io::RecordingWriter* recorder, LoopOptions options, PipelineSettings settings,
-                     std::function<void()> notify)
+                     std::function<void()> notify, SettingsHook onSettings)
     : source_(source),
       sinks_(std::move(sinks)),
       recorder_(recorder),
       options_(options),
       notify_(std::move(notify)),
+      onSettings_(std::move(onSettings)),
       queue_(options.queueCapacity, options.overflow),
       settings_(std::move(settings)) {}
 
@@ -173,14 +174,18 @@ void FrameLoop::runPipeline() {
             std::optional<core::FramePair> pair = pairer_.push(item.frame);
             if (!pair)
                 continue;
+            bool newSettings = false;
             {
                 std::lock_guard lock(mutex_);
                 ++statistics_.pairs;
                 if (settingsVersion != settingsVersion_) {
                     settings = settings_;
                     settingsVersion = settingsVersion_;
+                    newSettings = true;
                 }
             }
+            if (newSettings && onSettings_)
+                onSettings_(settings);
             tap_.offer(*pair);
             // Detection stages plug in here: the contacts of `*pair` under `settings` (calibration, touch
             // height). Until they exist no finger is ever reported.

@@ -42,6 +42,10 @@ struct PipelineSettings {
     double touchHeightMm = 0.0;                    // a finger at or below this height touches
 };
 
+// Runs on the pipeline thread when new settings take effect, before the next pair: the place for sinks that
+// depend on the calibration (the virtual touchscreen's size).
+using SettingsHook = std::function<void(const PipelineSettings&)>;
+
 // Carries frames from a source through pairing and the pipeline stages to the sinks: a camera thread reads
 // the source into a bounded queue, a pipeline thread pairs frames, runs the stages and publishes contacts.
 // The owner (the main thread) hears about news through `notify` and reads them here.
@@ -50,7 +54,8 @@ public:
     // `notify` runs on the loop's threads whenever the contacts change or the loop ends; it must be cheap and
     // thread-safe.
     FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks, io::RecordingWriter* recorder,
-              LoopOptions options, PipelineSettings settings, std::function<void()> notify);
+              LoopOptions options, PipelineSettings settings, std::function<void()> notify,
+              SettingsHook onSettings = nullptr);
     ~FrameLoop();
     FrameLoop(const FrameLoop&) = delete;
     FrameLoop& operator=(const FrameLoop&) = delete;
@@ -85,6 +90,7 @@ private:
     io::RecordingWriter* recorder_;
     LoopOptions options_;
     std::function<void()> notify_;
+    SettingsHook onSettings_;
     FrameQueue queue_;
     FrameTap tap_;
     core::FramePairer pairer_;  // pipeline thread only

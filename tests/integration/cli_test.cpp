@@ -16,8 +16,8 @@ using ::testing::HasSubstr;
 TEST(Everytouchd, HelpListsEveryOption) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--help"});
     EXPECT_EQ(result.exitCode, 0);
-    for (const char* option :
-         {"--config", "--rig", "--log", "--record", "--frames", "--fast", "--verbose", "--version"})
+    for (const char* option : {"--config", "--rig", "--log", "--output", "--record", "--frames", "--fast",
+                               "--verbose", "--version"})
         EXPECT_THAT(result.out, HasSubstr(option));
 }
 
@@ -67,6 +67,23 @@ TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
                        cv::Mat(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(160)), cv::NORM_INF),
               0.0);
     EXPECT_TRUE(io::readTouchLog(dir / "touches.jsonl").empty());
+}
+
+TEST(Everytouchd, UnknownOutputIsAUsageErrorNamingTheOption) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--output", "uinput,screen"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("--output screen"));
+}
+
+TEST(Everytouchd, VirtualTouchscreenWithoutUinputFailsNamingIt) {
+    if (std::filesystem::exists("/dev/uinput"))
+        GTEST_SKIP() << "/dev/uinput exists here; tests/vm checks the touchscreen it creates";
+    test::TempDir dir;
+    io::RecordingWriter(dir / "in", test::paperLikeRig(), false).flush();
+    const test::ProcessResult result = test::runProcess(
+        {EVERYTOUCHD_PATH, "--rig", "replay:" + (dir / "in").string(), "--fast", "--output", "uinput"});
+    EXPECT_EQ(result.exitCode, 1);
+    EXPECT_THAT(result.err, HasSubstr("/dev/uinput"));
 }
 
 TEST(EverytouchCalib, HelpDocumentsExitCodes) {

@@ -18,7 +18,6 @@
 #include "io/calibration_file.h"
 #include "io/handles.h"
 #include "service/bus_names.h"
-#include "support/background_process.h"
 #include "support/coded_recording.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
@@ -104,11 +103,11 @@ protected:
     void TearDown() override {
         if (daemon_ && daemon_->running()) {
             daemon_->signal(SIGTERM);
-            const std::optional<int> status = daemon_->waitExit(kExitTimeout);
+            const std::optional<int> status = daemon_->wait(kExitTimeout);
             EXPECT_EQ(status, 0) << "everytouchd did not stop cleanly on SIGTERM";
         }
         if (HasFailure() && daemon_)
-            std::cerr << "---- everytouchd log ----\n" << daemon_->log() << "-------------------------\n";
+            std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
     }
 
     std::filesystem::path configPath() const { return dir_ / "everytouchd.conf"; }
@@ -145,7 +144,7 @@ protected:
     bool waitForLog(const std::string& text) {
         const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
         while (std::chrono::steady_clock::now() < deadline) {
-            if (daemon_->log().find(text) != std::string::npos)
+            if (daemon_->output().find(text) != std::string::npos)
                 return true;
             std::this_thread::sleep_for(20ms);
         }
@@ -407,16 +406,16 @@ TEST_F(ServiceTest, SurvivesClientsThatDisconnectMidCall) {
 TEST_F(ServiceTest, SigtermStopsCleanlyAndReleasesContacts) {
     startDaemon({"--log", (dir_ / "touches.jsonl").string()});
     daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->waitExit(kExitTimeout), 0);
-    EXPECT_THAT(daemon_->log(), HasSubstr("stopping on TERM"));
-    EXPECT_THAT(daemon_->log(), HasSubstr("all contacts released"));
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_THAT(daemon_->output(), HasSubstr("stopping on TERM"));
+    EXPECT_THAT(daemon_->output(), HasSubstr("all contacts released"));
     EXPECT_TRUE(notify_->waitFor("STOPPING=1", 0ms));
 }
 
 TEST_F(ServiceTest, TheEndOfTheStreamEndsTheDaemon) {
     startDaemon({"--frames", "30", "--fast"});
-    EXPECT_EQ(daemon_->waitExit(kExitTimeout), 0);
-    EXPECT_THAT(daemon_->log(), HasSubstr("processed 30 frames (29 pairs)"));
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_THAT(daemon_->output(), HasSubstr("processed 30 frames (29 pairs)"));
 }
 
 TEST_F(ServiceTest, WatchdogIsPingedWhenSystemdAsks) {
@@ -463,7 +462,7 @@ TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     startDaemon();
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
     EXPECT_EQ(get("Calibrated"), "b false\n");
-    EXPECT_THAT(daemon_->log(), HasSubstr("calibration.yml: version: unsupported version"));
+    EXPECT_THAT(daemon_->output(), HasSubstr("calibration.yml: version: unsupported version"));
     const test::ProcessResult save = test::runProcess(call("SaveCalibration"));
     EXPECT_THAT(save.err, HasSubstr("There is no calibration to save"));
     EXPECT_EQ(fileContents(dir_ / "calibration.yml"), before);
@@ -628,12 +627,12 @@ TEST(EverytouchdService, WithoutACameraSaysSoAndExits) {
     test::BackgroundProcess daemon(
         {EVERYTOUCHD_PATH, "--service", "--config", (dir / "everytouchd.conf").string()}, dir / "log",
         {{"NOTIFY_SOCKET", notify.path().string()}});
-    EXPECT_EQ(daemon.waitExit(kExitTimeout), 6);
+    EXPECT_EQ(daemon.wait(kExitTimeout), 6);
     EXPECT_TRUE(notify.waitFor("STATUS=No camera configured: set [Camera] Rig= in " +
                                    (dir / "everytouchd.conf").string() + " (see everytouchd(8))",
                                kExitTimeout))
-        << daemon.log();
-    EXPECT_THAT(daemon.log(), HasSubstr("No camera configured"));
+        << daemon.output();
+    EXPECT_THAT(daemon.output(), HasSubstr("No camera configured"));
     EXPECT_FALSE(notify.waitFor("READY=1", 0ms));
 }
 

@@ -1,6 +1,12 @@
 #pragma once
 
+#include <sys/types.h>
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace everytouch::test {
@@ -14,5 +20,32 @@ struct ProcessResult {
 // Runs a program to completion with the given arguments, capturing its output. Fails the test if it cannot
 // start.
 ProcessResult runProcess(const std::vector<std::string>& argv);
+
+// A program running beside the test (searched in $PATH), its stdout and stderr going to `outputFile`.
+// Killed and reaped when the object goes, unless it ended before.
+class BackgroundProcess {
+public:
+    // `environment`: variables set for the program on top of this process's environment.
+    BackgroundProcess(const std::vector<std::string>& argv, const std::filesystem::path& outputFile,
+                      const std::vector<std::pair<std::string, std::string>>& environment = {});
+    ~BackgroundProcess();
+    BackgroundProcess(const BackgroundProcess&) = delete;
+    BackgroundProcess& operator=(const BackgroundProcess&) = delete;
+
+    pid_t pid() const { return pid_; }
+    // Whether the program holds `file` open right now.
+    bool hasOpen(const std::filesystem::path& file) const;
+    void signal(int number) const;
+    // The exit status (128 + signal number when killed), or nothing if it is still running after `timeout`.
+    std::optional<int> wait(std::chrono::milliseconds timeout);
+    bool running() { return !wait(std::chrono::milliseconds(0)); }
+    // What it has written so far.
+    std::string output() const;
+
+private:
+    std::filesystem::path outputFile_;
+    pid_t pid_ = -1;
+    std::optional<int> exitCode_;
+};
 
 }  // namespace everytouch::test
