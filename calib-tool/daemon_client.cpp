@@ -145,27 +145,35 @@ struct CalibrationFollower {
     bool daemonGone = false;
 };
 
-int onProgressSignal(sd_bus_message* message, void* userdata, sd_bus_error*) {
+int onProgressSignal(sd_bus_message* message, void* userdata, sd_bus_error*) noexcept {
     auto* follower = static_cast<CalibrationFollower*>(userdata);
     const char* step = nullptr;
     const char* text = nullptr;
     double fraction = 0.0;
-    if (sd_bus_message_read(message, "sds", &step, &fraction, &text) >= 0)
-        (*follower->onProgress)(step, fraction, text);
+    try {
+        if (sd_bus_message_read(message, "sds", &step, &fraction, &text) >= 0)
+            (*follower->onProgress)(step, fraction, text);
+    } catch (const std::exception&) {
+        // A progress line that cannot be shown is not worth stopping the calibration for.
+    }
     return 0;
 }
 
-int onFinishedSignal(sd_bus_message* message, void* userdata, sd_bus_error*) {
+int onFinishedSignal(sd_bus_message* message, void* userdata, sd_bus_error*) noexcept {
     auto* follower = static_cast<CalibrationFollower*>(userdata);
     int ok = 0;
     const char* text = nullptr;
     double rmsPx = 0.0;
-    if (sd_bus_message_read(message, "bsd", &ok, &text, &rmsPx) >= 0)
-        follower->result = DaemonClient::CalibrationResult{ok != 0, text, rmsPx};
+    try {
+        if (sd_bus_message_read(message, "bsd", &ok, &text, &rmsPx) >= 0)
+            follower->result = DaemonClient::CalibrationResult{ok != 0, text, rmsPx};
+    } catch (const std::exception&) {
+        follower->daemonGone = true;  // out of memory: stop waiting rather than wait forever
+    }
     return 0;
 }
 
-int onOwnerChanged(sd_bus_message* message, void* userdata, sd_bus_error*) {
+int onOwnerChanged(sd_bus_message* message, void* userdata, sd_bus_error*) noexcept {
     const char* name = nullptr;
     const char* oldOwner = nullptr;
     const char* newOwner = nullptr;

@@ -9,6 +9,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/code_image.h"
+
 namespace everytouch::service {
 
 std::optional<SnapshotKind> parseSnapshotKind(std::string_view name) {
@@ -26,24 +28,16 @@ bool snapshotNeedsDetection(std::string_view name) {
 }
 
 void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
-    const cv::Mat& positive = pair.positive.image;
-    const cv::Mat& negative = pair.negative.image;
-    switch (kind) {
-        case SnapshotKind::Camera:
-            pair.latest().image.copyTo(image);
-            return;
-        case SnapshotKind::Texture:
-            cv::addWeighted(positive, 0.5, negative, 0.5, 0.0, image);
-            return;
-        case SnapshotKind::Subtraction: {
-            cv::Mat difference;
-            cv::subtract(positive, negative, difference, cv::noArray(), CV_16S);
-            cv::Mat largest = difference.reshape(1, difference.total());
-            cv::reduce(largest, largest, 1, cv::REDUCE_MAX);
-            largest.reshape(1, difference.rows).convertTo(image, CV_8U);
-            return;
-        }
+    if (kind == SnapshotKind::Camera) {
+        pair.latest().image.copyTo(image);
+        return;
     }
+    cv::Mat subtraction, texture;
+    core::computeSubtractionAndTexture(pair, subtraction, texture);
+    if (kind == SnapshotKind::Texture)
+        image = texture;
+    else
+        subtraction.convertTo(image, CV_8U);  // saturates: negative differences become 0
 }
 
 std::vector<unsigned char> encodePng(const cv::Mat& image) {

@@ -137,6 +137,7 @@ protected:
         while (std::chrono::steady_clock::now() < deadline) {
             if (test::runProcess(property("get-property", name)).out == expected + "\n")
                 return true;
+            std::this_thread::sleep_for(20ms);
         }
         return false;
     }
@@ -185,8 +186,10 @@ TEST_F(ServiceTest, StatisticsFollowTheCamera) {
     startDaemon();
     const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
     double frameRate = 0.0;
-    while (std::chrono::steady_clock::now() < deadline && !(frameRate > 8.0 && frameRate < 12.0))
+    while (std::chrono::steady_clock::now() < deadline && !(frameRate > 8.0 && frameRate < 12.0)) {
+        std::this_thread::sleep_for(100ms);
         std::sscanf(get("FrameRate").c_str(), "d %lf", &frameRate);
+    }
     EXPECT_GT(frameRate, 8.0);  // the recording runs at 10 frames/s
     EXPECT_LT(frameRate, 12.0);
     EXPECT_THAT(get("LatencyMs"), HasSubstr("d "));
@@ -230,8 +233,8 @@ TEST_F(ServiceTest, TouchHeightIsSetAndRangeChecked) {
               0);
     const io::BusSlot match(slot);
 
-    test::ProcessResult result = test::runProcess(property("set-property", "TouchHeightMm"));
-    result = test::runProcess(concat(property("set-property", "TouchHeightMm"), {"d", "7.5"}));
+    test::ProcessResult result =
+        test::runProcess(concat(property("set-property", "TouchHeightMm"), {"d", "7.5"}));
     ASSERT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("TouchHeightMm"), "d 7.5\n");
     const auto deadline = std::chrono::steady_clock::now() + 10s;
