@@ -103,6 +103,37 @@ int Daemon::run() {
     ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe();
     const std::optional<io::RigDescription> rig = source_->rig();
 
+    loadCalibration(rig);
+
+    if (!options_.recordDir.empty()) {
+        if (!rig)
+            throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
+        recorder_ = std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, false);
+    }
+    if (const int r = startEventLoop(); r < 0)
+        throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
+    connectBus();
+    startFrameLoop(openOutputs());
+    startWatchdog();
+
+    ready_ = true;
+    reportedCalibrated_ = calibrated();
+    refreshState();
+    sd_notify(0, "READY=1");
+    notifyStatus();
+
+    const int r = sd_event_loop(event_.get());
+    if (r < 0) {
+        ET_LOG(Error) << "the event loop failed: " << std::strerror(-r);
+        exitStatus_ = kExitFailure;
+    } else if (r != kExitSuccess) {
+        exitStatus_ = r;
+    }
+    shutDown();
+    return exitStatus_;
+}
+
+void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
     std::filesystem::path storePath = config_.calibrationPath;
     if (storePath.empty() && cameraRig_)
         storePath = kDefaultCalibrationPath;
@@ -116,12 +147,9 @@ int Daemon::run() {
     else
         ET_LOG(Info) << "calibration from "
                      << (store_->keepsFile() ? store_->path().string() : std::string("the rig itself"));
+}
 
-    if (!options_.recordDir.empty()) {
-        if (!rig)
-            throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
-        recorder_ = std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, false);
-    }
+std::vector<io::TouchSink*> Daemon::openOutputs() {
     std::vector<io::TouchSink*> sinks;
     // A person at the terminal sees the touches; the journal of a service would only fill up with them.
     if (!options_.service) {
@@ -132,11 +160,6 @@ int Daemon::run() {
         touchLog_ = std::make_unique<io::TouchLogWriter>(options_.touchLog);
         sinks.push_back(touchLog_.get());
     }
-
-    if (const int r = startEventLoop(); r < 0)
-        throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
-    connectBus();
-
     const bool uinputAsked = std::ranges::find(options_.outputs, "uinput") != options_.outputs.end();
     if (uinputAsked || config_.uinput.value_or(cameraRig_)) {
         touchscreen_ = std::make_unique<TouchscreenOutput>([this](const std::string& devnode) {
@@ -154,7 +177,10 @@ int Daemon::run() {
                    "the calibration";
         sinks.push_back(touchscreen_.get());
     }
+    return sinks;
+}
 
+void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
     LoopOptions loopOptions;
     loopOptions.maxFrames = options_.maxFrames;
     loopOptions.queueCapacity = kQueueFrames;
@@ -173,23 +199,6 @@ int Daemon::run() {
             }
         });
     loop_->start();
-    startWatchdog();
-
-    ready_ = true;
-    reportedCalibrated_ = calibrated();
-    refreshState();
-    sd_notify(0, "READY=1");
-    notifyStatus();
-
-    const int r = sd_event_loop(event_.get());
-    if (r < 0) {
-        ET_LOG(Error) << "the event loop failed: " << std::strerror(-r);
-        exitStatus_ = kExitFailure;
-    } else if (r != kExitSuccess) {
-        exitStatus_ = r;
-    }
-    shutDown();
-    return exitStatus_;
 }
 
 int Daemon::startEventLoop() {

@@ -107,7 +107,10 @@ private:
         std::atomic<bool> cancelled{false};
     };
 
+    void loadCalibration(const std::optional<io::RigDescription>& rig);
+    std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
+    void startFrameLoop(std::vector<io::TouchSink*> sinks);
     void connectBus();
     void startWatchdog();
     void onLoopNews();
