@@ -9,14 +9,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Statistics are smoothed with this time constant: long enough to be readable, short enough to follow a
-// camera that slows down.
+// The latency is smoothed with this time constant: long enough to be readable, short enough to follow a
+// pipeline that slows down.
 constexpr double kSmoothingSeconds = 1.0;
 // The pipeline thread wakes at least this often, so its heartbeat shows it is alive while no frame comes.
 constexpr std::chrono::milliseconds kPipelineWake{100};
 
-double smoothingWeight(double elapsedS) {
-    return 1.0 - std::exp(-elapsedS / kSmoothingSeconds);
+// The weight of one new sample when samples come at `perSecond`, so that a second's worth of them counts
+// as much as everything before.
+double smoothingWeight(double perSecond) {
+    return perSecond > 0.0 ? 1.0 - std::exp(-1.0 / (perSecond * kSmoothingSeconds)) : 1.0;
 }
 
 }  // namespace
@@ -71,6 +73,7 @@ LoopStatistics FrameLoop::statistics() const {
     std::lock_guard lock(mutex_);
     LoopStatistics statistics = statistics_;
     statistics.dropped = queue_.dropped();
+    statistics.frameRate = arrivals_.perSecond(Clock::now());
     if (!finished_)
         statistics.seconds = std::chrono::duration<double>(Clock::now() - started_).count();
     return statistics;
@@ -114,15 +117,7 @@ void FrameLoop::runCamera() {
         item.arrival = Clock::now();
         {
             std::lock_guard lock(mutex_);
-            if (statistics_.frames > 0) {
-                const double intervalS = std::chrono::duration<double>(item.arrival - lastArrival_).count();
-                frameIntervalS_ =
-                    statistics_.frames == 1
-                        ? intervalS
-                        : frameIntervalS_ + smoothingWeight(intervalS) * (intervalS - frameIntervalS_);
-                statistics_.frameRate = frameIntervalS_ > 0.0 ? 1.0 / frameIntervalS_ : 0.0;
-            }
-            lastArrival_ = item.arrival;
+            arrivals_.add(item.arrival);
             ++statistics_.frames;
         }
         if (!queue_.push(std::move(item)))
@@ -192,10 +187,9 @@ void FrameLoop::runPipeline() {
             publish(item.frame.index, item.frame.timestampUs, noContacts);
             const double latencyS = std::chrono::duration<double>(Clock::now() - item.arrival).count();
             std::lock_guard lock(mutex_);
-            statistics_.latencyMs =
-                statistics_.pairs == 1 ? 1e3 * latencyS
-                                       : statistics_.latencyMs + smoothingWeight(frameIntervalS_) *
-                                                                     (1e3 * latencyS - statistics_.latencyMs);
+            const double weight =
+                statistics_.pairs == 1 ? 1.0 : smoothingWeight(arrivals_.perSecond(Clock::now()));
+            statistics_.latencyMs += weight * (1e3 * latencyS - statistics_.latencyMs);
         }
     } catch (const std::exception& error) {
         fail(std::string("pipeline: ") + error.what());

@@ -16,6 +16,7 @@
 #include "io/frame_source.h"
 #include "io/recording.h"
 #include "io/touch_sink.h"
+#include "service/arrival_rate.h"
 #include "service/frame_queue.h"
 #include "service/frame_tap.h"
 
@@ -25,9 +26,9 @@ struct LoopStatistics {
     std::uint64_t frames = 0;   // camera frames taken from the source
     std::uint64_t pairs = 0;    // frame pairs formed
     std::uint64_t dropped = 0;  // frames dropped because the pipeline fell behind the camera
-    double frameRate = 0.0;     // camera frames per second as they arrive, smoothed over about a second
-    double latencyMs = 0.0;     // from a frame's arrival to its contacts reaching the sinks, smoothed
-    double seconds = 0.0;       // wall-clock time since start, or of the whole run once finished
+    double frameRate = 0.0;     // camera frames per second over the last second
+    double latencyMs = 0.0;  // from a frame's arrival to its contacts reaching the sinks, smoothed over ~1 s
+    double seconds = 0.0;    // wall-clock time since start, or of the whole run once finished
 };
 
 struct LoopOptions {
@@ -104,8 +105,7 @@ private:
     mutable std::mutex mutex_;  // guards everything below
     LoopStatistics statistics_;
     std::chrono::steady_clock::time_point started_;
-    std::chrono::steady_clock::time_point lastArrival_;
-    double frameIntervalS_ = 0.0;
+    ArrivalRate arrivals_;
     core::Contacts contacts_;
     std::uint64_t contactsVersion_ = 0;
     std::optional<std::string> failure_;

@@ -84,7 +84,6 @@ TEST_F(FrameLoopTest, RunsToTheEndOfTheStreamAndReleasesTheContacts) {
     EXPECT_EQ(statistics.frames, 20u);
     EXPECT_EQ(statistics.pairs, 19u);
     EXPECT_EQ(statistics.dropped, 0u);
-    EXPECT_GT(statistics.frameRate, 0.0);
     EXPECT_FALSE(loop.failure());
     const std::vector<std::uint64_t> indices = sink.indices();
     ASSERT_EQ(indices.size(), 20u);  // one per pair, then the release
