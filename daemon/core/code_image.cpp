@@ -94,15 +94,11 @@ void binarizeSubtraction(const cv::Mat& subtraction, int frameChannels, const Bi
             const float amplitude = 2.0f * (threshold[x] - zeroLevel);
             const float value = s[x];
             const float excess = value - threshold[x];
-            if (amplitude < minAmplitude || value < lowest) {
-                bit[x] = kUnknownBit;
-                continue;
-            }
-            const float margin = std::max(noiseScale / amplitude, mixtureMargin * amplitude);
-            if (std::abs(excess) < margin)
-                bit[x] = kUnknownBit;
-            else
-                bit[x] = excess > 0 ? kOneBit : kZeroBit;
+            const float distance = std::abs(excess);
+            // distance * amplitude < noiseScale: the bit is wrong with a probability above the limit.
+            const bool unreadable = amplitude <= 0.0f || amplitude < minAmplitude || value < lowest ||
+                                    distance * amplitude < noiseScale || distance < mixtureMargin * amplitude;
+            bit[x] = unreadable ? kUnknownBit : excess > 0 ? kOneBit : kZeroBit;
         }
     }
 }

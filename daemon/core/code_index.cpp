@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 
 #include <opencv2/core.hpp>
 
@@ -47,6 +48,16 @@ std::uint64_t CodeIndex::chunkOf(int chunk, std::uint64_t code) const {
     return (code >> shift) & ((std::uint64_t{1} << chunkBits_) - 1);
 }
 
+double CodeIndex::chanceMatches(int knownBits, int mismatches) const {
+    double sum = 0;
+    double binomial = 1;  // C(knownBits, j)
+    for (int j = 0; j <= mismatches && j <= knownBits; ++j) {
+        sum += binomial;
+        binomial = binomial * (knownBits - j) / (j + 1);
+    }
+    return static_cast<double>(entries_.size()) * std::ldexp(sum, -knownBits);
+}
+
 std::optional<cv::Point> CodeIndex::find(std::uint64_t code) const {
     const auto it =
         std::lower_bound(entries_.begin(), entries_.end(), code,
@@ -60,11 +71,14 @@ std::optional<CodeMatch> CodeIndex::match(const ObservedCode& observed, int maxM
     int best = -1;
     int bestMismatches = std::numeric_limits<int>::max();
     int runnerUp = std::numeric_limits<int>::max();
-    for (int chunk = 0; chunk < kChunks; ++chunk) {
+    // A window not yet examined disagrees with the observation on a known bit of every chunk searched so far.
+    int searchedChunks = 0;
+    for (int chunk = 0; chunk < kChunks && bestMismatches > searchedChunks; ++chunk) {
         const std::uint64_t unknown = chunkOf(chunk, ~observed.known & codeMask_);
         const int unknownCount = std::popcount(unknown);
         if (unknownCount > kMaxUnknownPerChunk)
             continue;
+        ++searchedChunks;
         const std::uint64_t seen = chunkOf(chunk, observed.bits & observed.known);
         // Every assignment of the unknown bits: the submasks of `unknown`.
         std::uint64_t filling = 0;

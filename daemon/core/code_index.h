@@ -18,7 +18,8 @@ struct CodeMatch {
     cv::Point position;  // projector pixel: the bottom-right pixel (anchor) of the matching window
     int mismatches = 0;  // Hamming distance to the observation over its known bits
     // Smallest distance of any other window the search examined (those that agree with the observation on a
-    // whole chunk); a gap to `mismatches` says how unambiguous the match is. INT_MAX when there was none.
+    // whole chunk, until no unexamined window can be closer than the best); a gap to `mismatches` says how
+    // unambiguous the match is. INT_MAX when there was none.
     int runnerUpMismatches = std::numeric_limits<int>::max();
 };
 
@@ -39,6 +40,10 @@ public:
     // one of the codeword's four chunks (window*window/4 bits each) has no wrong bit and at most four unknown
     // bits, so any observation with at most three wrong bits and few unknown ones.
     std::optional<CodeMatch> match(const ObservedCode& observed, int maxMismatches) const;
+
+    // Expected number of windows that agree with a random observation of `knownBits` bits in all but at most
+    // `mismatches` of them: how likely a match that good is a coincidence. size() * sum_{j<=m} C(k, j) / 2^k.
+    double chanceMatches(int knownBits, int mismatches) const;
 
 private:
     static constexpr int kChunks = 4;

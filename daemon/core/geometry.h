@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -21,5 +23,15 @@ Eigen::Vector2d projectPoint(const Eigen::Matrix3d& intrinsics, const Eigen::Iso
                              const Eigen::Vector3d& pointInTable);
 
 Eigen::Vector2d applyHomography(const Eigen::Matrix3d& homography, const Eigen::Vector2d& point);
+
+// The homography taking `from` to `to` (at least four pairs, no three of the first four collinear): the
+// normalised direct linear transform, exact for four pairs, algebraic least squares for more. Bottom-right
+// element 1.
+Eigen::Matrix3d fitHomography(const std::vector<Eigen::Vector2d>& from,
+                              const std::vector<Eigen::Vector2d>& to);
+
+// Rotation vector (axis times angle, radians; Rodrigues) <-> rotation matrix.
+Eigen::Matrix3d rotationFromVector(const Eigen::Vector3d& rotationVector);
+Eigen::Vector3d vectorFromRotation(const Eigen::Matrix3d& rotation);
 
 }  // namespace everytouch::core

@@ -46,16 +46,22 @@ public:
         : bits_(bits),
           grid_(anchorGrid(bits.size(), options.window)),
           neighbourRadius_(options.neighbourRadius),
-          radius_(options.minDistance - 1),
-          table_(options.window * options.window, grid_.count(), radius_),
           rng_(options.seed ^ 0x5DEECE66Dull) {}
 
-    void run(long long trialBudget) {
+    // Raises the minimum distance one level at a time: first no identical windows, then none at distance 1,
+    // and so on. Lower levels are cheaper to search and their pairs the more harmful, and a level once
+    // reached is kept by every later flip. Stops at minDistance or when the trial budget is spent.
+    void run(int minDistance, long long trialBudget) {
+        long long trials = 0;
+        for (int radius = 0; radius < minDistance && trials < trialBudget; ++radius)
+            repairLevel(radius, trialBudget, trials);
+    }
+
+private:
+    void repairLevel(int radius, long long trialBudget, long long& trials) {
         const std::vector<std::uint64_t> codes = windowCodes(bits_, grid_.window);
-        for (int id = 0; id < grid_.count(); ++id)
-            table_.insert(id, codes[id]);
         std::vector<char> conflicted(codes.size(), 0);
-        forEachPairWithin(codes, grid_.window * grid_.window, radius_, [&](int a, int b, int distance) {
+        forEachPairWithin(codes, grid_.window * grid_.window, radius, [&](int a, int b, int distance) {
             if (conflicting(a, b, distance))
                 conflicted[a] = conflicted[b] = 1;
         });
@@ -63,8 +69,12 @@ public:
         for (int id = 0; id < grid_.count(); ++id)
             if (conflicted[id])
                 queue.push_back(id);
+        if (queue.empty())
+            return;
+        table_.emplace(grid_.window * grid_.window, grid_.count(), radius);
+        for (int id = 0; id < grid_.count(); ++id)
+            table_->insert(id, codes[id]);
         std::vector<cv::Point> pixels;
-        long long trials = 0;
         while (!queue.empty() && trials < trialBudget) {
             const int id = queue.back();
             queue.pop_back();
@@ -110,7 +120,7 @@ private:
 
     bool inConflict(int id) const {
         bool found = false;
-        table_.forEachWithin(table_.code(id), [&](int other, int distance) {
+        table_->forEachWithin(table_->code(id), [&](int other, int distance) {
             found = found || conflicting(id, other, distance);
         });
         return found;
@@ -145,7 +155,7 @@ private:
         const cv::Rect anchors = affectedAnchors(pixel);
         ConflictCounts counts{};
         forEachAffected(pixel, [&](int id) {
-            table_.forEachWithin(table_.code(id), [&](int other, int distance) {
+            table_->forEachWithin(table_->code(id), [&](int other, int distance) {
                 if (!conflicting(id, other, distance))
                     return;
                 if (other < id && anchors.contains({grid_.x(other), grid_.y(other)}))
@@ -161,17 +171,16 @@ private:
         forEachAffected(pixel, [&](int id) {
             const int bit = (pixel.y - (grid_.y(id) - grid_.window + 1)) * grid_.window +
                             (pixel.x - (grid_.x(id) - grid_.window + 1));
-            const std::uint64_t code = table_.code(id) ^ (std::uint64_t{1} << bit);
-            table_.remove(id);
-            table_.insert(id, code);
+            const std::uint64_t code = table_->code(id) ^ (std::uint64_t{1} << bit);
+            table_->remove(id);
+            table_->insert(id, code);
         });
     }
 
     cv::Mat& bits_;
     AnchorGrid grid_;
     int neighbourRadius_;
-    int radius_;
-    NearCodewordTable table_;
+    std::optional<NearCodewordTable> table_;  // the codewords, searched to the radius of the current level
     std::mt19937_64 rng_;
 };
 
@@ -217,7 +226,7 @@ cv::Mat generatePattern(const PatternOptions& options) {
     if (options.minDistance > 0) {
         PatternRepair repair(bits, options);
         const double windows = static_cast<double>(anchorGrid(options.size, options.window).count());
-        repair.run(static_cast<long long>(options.repairTrialsPerWindow * windows));
+        repair.run(options.minDistance, static_cast<long long>(options.repairTrialsPerWindow * windows));
     }
     return bits;
 }

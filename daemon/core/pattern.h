@@ -24,18 +24,19 @@ struct PatternOptions {
     int window = 6;           // codeword window side; window*window <= 64 bits
     std::uint64_t seed = 1;   // same seed, same pattern
     // Target of the repair pass: windows whose anchors are more than neighbourRadius apart differ in at least
-    // this many bits. 0: no repair (the paper's plain random pattern, which may repeat codewords); 1: every
-    // codeword unique. With 6x6 windows on 640x480, 4 is reached in well under a second; 5 is beyond what
-    // single-bit flips can reach (about 10 new near pairs per flip).
+    // this many bits. 0: no repair (the paper's plain random pattern, which repeats a codeword about every
+    // other seed at 640x480); 1: every codeword unique. The pass raises the minimum one level at a time. With
+    // 6x6 windows on 640x480, 4 takes about 10 000 trial flips (under a second); 5 is out of reach of
+    // single-bit flips (each creates about 10 new near pairs): the pass spends its budget and leaves 4.
     int minDistance = 4;
     // Windows whose anchors are at most this many pixels apart (Chebyshev) may be closer than minDistance
     // (never identical): mistaking one for the other misplaces a code by that many projector pixels, which is
     // within what the camera-projector homography resolves anyway.
     int neighbourRadius = 1;
-    // Upper bound on the bit flips the repair pass tries, per window of the pattern. Bounds the generation
-    // time when minDistance is out of reach; the pass stops earlier once the target holds (typically after a
-    // few thousandths of this at the defaults).
-    double repairTrialsPerWindow = 0.5;
+    // Upper bound on the bit flips the repair pass tries, per window of the pattern (0.1: 30 000 at 640x480,
+    // three times what the default target needs). Bounds the generation time when minDistance is out of
+    // reach; the pass stops as soon as the target holds.
+    double repairTrialsPerWindow = 0.1;
 
     // The first problem found, naming the field; nothing when the options are usable.
     std::optional<std::string> validate() const;

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/embedding.h"
+#include "core/pattern.h"
 #include "support/test_rig.h"
 
 namespace everytouch::test {
@@ -35,6 +36,11 @@ core::Frame expose(const SyntheticScene& scene, const cv::Mat& shown, const cv::
 }
 
 }  // namespace
+
+const cv::Mat& defaultPattern() {
+    static const cv::Mat pattern = core::generatePattern({});
+    return pattern;
+}
 
 core::FramePair renderCapture(const SyntheticScene& scene) {
     CV_Assert(scene.pattern.type() == CV_8UC1 && scene.content.type() == CV_8UC3 &&

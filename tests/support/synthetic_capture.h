@@ -29,6 +29,9 @@ struct SyntheticScene {
     std::uint64_t seed = 1;             // noise
 };
 
+// The default pattern, core::generatePattern({}), generated once per process.
+const cv::Mat& defaultPattern();
+
 // The two frames of one pair: positive shows O + P, negative O - P.
 core::FramePair renderCapture(const SyntheticScene& scene);
 

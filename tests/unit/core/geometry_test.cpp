@@ -47,5 +47,35 @@ TEST(Geometry, HomographyRoundTripIsIdentity) {
               1e-9);
 }
 
+TEST(Geometry, FitHomographyIsExactForFourPointsAndAgreesWithMore) {
+    const Calibration calibration = test::paperLikeCalibration();
+    const Eigen::Matrix3d truth = calibration.tableToCameraHomography();
+    std::vector<Eigen::Vector2d> table, image;
+    for (const Eigen::Vector2d& point :
+         {Eigen::Vector2d(0, 0), Eigen::Vector2d(85.5, 0), Eigen::Vector2d(85.5, 12.5),
+          Eigen::Vector2d(0, 12.5), Eigen::Vector2d(40, 200), Eigen::Vector2d(300, 90)}) {
+        table.push_back(point);
+        image.push_back(applyHomography(truth, point));
+    }
+    const std::vector<Eigen::Vector2d> firstFour(table.begin(), table.begin() + 4),
+        firstFourImage(image.begin(), image.begin() + 4);
+    for (const Eigen::Matrix3d& fitted :
+         {fitHomography(firstFour, firstFourImage), fitHomography(table, image)})
+        for (const Eigen::Vector2d& point : {Eigen::Vector2d(150, 150), Eigen::Vector2d(-30, 260)})
+            EXPECT_LT((applyHomography(fitted, point) - applyHomography(truth, point)).norm(), 1e-6);
+}
+
+TEST(Geometry, RotationVectorRoundTrips) {
+    for (const Eigen::Vector3d& vector : {Eigen::Vector3d(0.1, -0.2, 0.3), Eigen::Vector3d(0, 0, 3.0),
+                                          Eigen::Vector3d(1e-14, 0, 0), Eigen::Vector3d(0, 0, 0)}) {
+        const Eigen::Matrix3d rotation = rotationFromVector(vector);
+        EXPECT_TRUE((rotation.transpose() * rotation).isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+        EXPECT_LT((vectorFromRotation(rotation) - vector).norm(), 1e-12);
+    }
+    EXPECT_TRUE(
+        rotationFromVector({0, 0, M_PI / 2})
+            .isApprox(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(), 1e-12));
+}
+
 }  // namespace
 }  // namespace everytouch::core
