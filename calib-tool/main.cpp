@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
     CLI::App* statusCommand =
         app.add_subcommand("status", "Show the daemon's state, rig, calibration and rates");
 
-    std::string step = "full";
+    std::string step = "table";
     DaemonClient::CalibrationOptions options;
     bool noSave = false;
     CLI::App* calibrateCommand = app.add_subcommand(

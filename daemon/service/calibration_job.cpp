@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "service/table_set_up_step.h"
+
 namespace everytouch::service {
 
 namespace {
@@ -11,14 +13,20 @@ namespace {
 constexpr unsigned kMaxPairsPerStep = 120;  // one second of a 120 Hz camera
 constexpr double kMaxCardSideMm = 1000.0;   // larger than any table the rig sees
 
+// The one-time calibration of the rigid projector-camera pair needs a board in several tilted poses, each
+// captured on the user's word; core::calibrateProjectorCameraPair exists, the capture dialogue does not yet.
 CalibrationStep projectorStep() {
-    return {"projector", "the projected chessboard seen by the camera (H_CP)",
-            "Keep the table clear: the projector shows a chessboard", nullptr};
+    return {"projector",
+            "the one-time calibration of the projector-camera pair from several poses of a board",
+            "Hold the board still in the next pose", nullptr};
 }
 
 CalibrationStep tableStep() {
-    return {"table", "a card of known size lying on the table (H_TC)",
-            "Lay the card flat on the table inside the projected area", nullptr};
+    return {
+        "table", "the table set-up from the projected chessboard and the card (H_CP, H_TC, keystone)",
+        "The projector shows a chessboard: keep the table clear and lay the card flat in the white border "
+        "below the board",
+        setUpTableFromPairs};
 }
 
 }  // namespace

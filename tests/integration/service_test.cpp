@@ -15,13 +15,17 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/geometry.h"
 #include "io/calibration_file.h"
 #include "io/handles.h"
+#include "io/recording.h"
 #include "service/bus_names.h"
+#include "service/table_set_up_step.h"
 #include "support/coded_recording.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
 #include "support/process.h"
+#include "support/surface_renderer.h"
 #include "support/temp_dir.h"
 #include "support/test_group.h"
 #include "support/test_rig.h"
@@ -86,6 +90,54 @@ private:
     std::filesystem::path path_;
 };
 
+// The paper-like rig with a lens that bends lines by a few pixels: the truth a calibration must recover.
+core::Calibration trueRig() {
+    core::Calibration rig = test::paperLikeCalibration();
+    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
+    return rig;
+}
+
+// A recording of the table while the projector shows the set-up board and the card's stripe lies in the
+// white border below it: 400 frames at 20 frames/s, rendered with 2 DN of sensor noise.
+class CalibrationSceneRecording {
+public:
+    static const std::filesystem::path& path() {
+        static CalibrationSceneRecording recording;
+        return recording.path_;
+    }
+
+private:
+    CalibrationSceneRecording() : path_(directory_ / "scene") {
+        std::filesystem::permissions(directory_.path(), std::filesystem::perms(0755));
+        io::RigDescription rig = test::paperLikeRig();
+        rig.calibration = trueRig();
+        test::SurfaceScene scene;
+        scene.rig = rig.calibration;
+        test::DarkRectangle stripe;
+        stripe.originMm = core::applyHomography(rig.calibration.tableToProjectorHomography().inverse(),
+                                                Eigen::Vector2d(320, 420)) -
+                          Eigen::Vector2d(85.5 / 2, 12.5 / 2);
+        scene.rectangles.push_back(stripe);
+        cv::Mat board;
+        core::renderProjectorChessboard(service::tableSetUpChessboard(), rig.calibration.projectorSize,
+                                        board);
+        const cv::Mat images[2] = {test::renderSurface(scene, board, 2.0, 1),
+                                   test::renderSurface(scene, board, 2.0, 2)};
+        io::RecordingWriter writer(path_, rig, false);
+        for (std::uint64_t i = 0; i < 400; ++i) {
+            core::Frame frame;
+            frame.index = i;
+            frame.timestampUs = static_cast<std::int64_t>(i) * 50'000;
+            frame.polarity = i % 2 ? core::Polarity::Negative : core::Polarity::Positive;
+            frame.image = images[i % 2];
+            writer.addFrame(frame);
+        }
+        writer.flush();
+    }
+    test::TempDir directory_;
+    std::filesystem::path path_;
+};
+
 // Starts everytouchd per test on a private bus; prints its log when the test fails.
 class ServiceTest : public ::testing::Test {
 protected:
@@ -118,14 +170,15 @@ protected:
     }
 
     void startDaemon(const std::vector<std::string>& extra = {},
-                     const std::vector<std::pair<std::string, std::string>>& environment = {}) {
+                     const std::vector<std::pair<std::string, std::string>>& environment = {},
+                     const std::filesystem::path& recording = SharedRecording::path()) {
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
         std::vector<std::pair<std::string, std::string>> variables = {
             {"NOTIFY_SOCKET", notify_->path().string()}};
         variables.insert(variables.end(), environment.begin(), environment.end());
         daemon_ = std::make_unique<test::BackgroundProcess>(
             concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig",
-                    "replay:" + SharedRecording::path().string()},
+                    "replay:" + recording.string()},
                    extra),
             dir_ / "everytouchd.log", variables);
         ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
@@ -298,18 +351,94 @@ TEST_F(ServiceTest, CalibrateRejectsBadArgumentsWithoutChangingState) {
     EXPECT_TRUE(daemon_->running());
 }
 
-TEST_F(ServiceTest, CalibrateFailsClearlyWhileItsEstimatorsAreMissing) {
+TEST_F(ServiceTest, CalibrateSaysWhichStepsThisBuildCannotRun) {
     startDaemon();
-    const test::ProcessResult direct = test::runProcess(concat(call("Calibrate"), {"sa{sv}", "table", "0"}));
+    const test::ProcessResult direct = test::runProcess(concat(call("Calibrate"), {"sa{sv}", "full", "0"}));
     EXPECT_NE(direct.exitCode, 0);
     EXPECT_THAT(direct.err,
-                HasSubstr("The table step (a card of known size lying on the table (H_TC)) is not part "
-                          "of this build yet; the current calibration stays active"));
+                HasSubstr("The projector step (the one-time calibration of the projector-camera pair "
+                          "from several poses of a board) is not part of this build yet; the current "
+                          "calibration stays active"));
     const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "projector"});
     EXPECT_EQ(tool.exitCode, 1);
     EXPECT_THAT(tool.err, HasSubstr("Calibration failed: The projector step"));
     EXPECT_EQ(get("State"), "s \"running\"\n");
     EXPECT_EQ(get("Calibrated"), "b true\n");
+}
+
+TEST_F(ServiceTest, AFailedCalibrationKeepsThePreviousOne) {
+    startDaemon();
+    const test::ProcessResult tool =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "2", "--no-save"});
+    EXPECT_EQ(tool.exitCode, 1);
+    EXPECT_THAT(tool.err, HasSubstr("table: The projector shows a chessboard"));
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: the table step failed: the projected chessboard: "));
+    EXPECT_THAT(tool.err, HasSubstr("The previous calibration stays active."));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+}
+
+TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
+    // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
+    // degrees under the unchanged projector-camera pair.
+    const core::Calibration truth = trueRig();
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemon({}, {}, CalibrationSceneRecording::path());
+
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    EXPECT_THAT(tool.err, HasSubstr("100% table: Done with the table set-up"));
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    EXPECT_THAT(tool.out, HasSubstr("Saved"));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+
+    // The saved calibration maps the projector onto the camera through the table as the truth does, wherever
+    // the projector lights it (the table frame itself is now the card's).
+    const core::Calibration saved = io::readCalibrationFile(dir_ / "calibration.yml");
+    double worstPx = 0;
+    for (double x = 40; x <= 600; x += 80)
+        for (double y = 40; y <= 440; y += 80) {
+            const Eigen::Vector2d projector(x, y);
+            worstPx =
+                std::max(worstPx, (core::applyHomography(saved.projectorToCameraHomography(), projector) -
+                                   core::applyHomography(truth.projectorToCameraHomography(), projector))
+                                      .norm());
+        }
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_projector_to_camera_px", std::to_string(worstPx));
+    EXPECT_LT(worstPx, 0.5);
+    double movedWorstPx = 0;
+    for (const Eigen::Vector2d& projector : {Eigen::Vector2d(40, 40), Eigen::Vector2d(600, 440)})
+        movedWorstPx =
+            std::max(movedWorstPx, (core::applyHomography(moved.projectorToCameraHomography(), projector) -
+                                    core::applyHomography(truth.projectorToCameraHomography(), projector))
+                                       .norm());
+    RecordProperty("stored_worst_projector_to_camera_px", std::to_string(movedWorstPx));
+    EXPECT_GT(movedWorstPx, 2.0) << "the stored calibration should have been off before";
+    EXPECT_FALSE(saved.validate());
+}
+
+TEST_F(ServiceTest, ASecondCalibrationWhileOneRunsIsBusy) {
+    startDaemon({}, {}, CalibrationSceneRecording::path());
+    test::BackgroundProcess tool(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "100", "--no-save"},
+        dir_ / "calibrate.log");
+    EXPECT_TRUE(waitForProperty("State", "s \"calibrating\""));
+    test::ProcessResult result = test::runProcess(call("Calibrate", {"sa{sv}", "table", "0"}));
+    EXPECT_THAT(result.err, HasSubstr("A calibration is already running"));
+    result = test::runProcess(call("ResetCalibration"));
+    EXPECT_THAT(result.err, HasSubstr("A calibration is running"));
+    EXPECT_EQ(tool.wait(kExitTimeout), 0) << tool.output();
+    EXPECT_EQ(get("State"), "s \"running\"\n");
 }
 
 TEST_F(ServiceTest, AnUnprivilegedCallerCanReadButNotChangeAnything) {

@@ -55,6 +55,7 @@ TEST(CalibrationJob, ThisBuildNamesTheStepsWithoutEstimator) {
     ASSERT_TRUE(missing);
     EXPECT_THAT(*missing, HasSubstr("projector step"));
     EXPECT_THAT(*missing, HasSubstr("not part of this build"));
+    EXPECT_FALSE(missingEstimator(*calibrationSteps("table")));
 }
 
 TEST(CalibrationJob, OptionsAreRangeChecked) {
