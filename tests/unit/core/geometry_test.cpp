@@ -39,6 +39,30 @@ TEST(Geometry, ElevatedPlaneHomographyOfEquation22AgreesWithDirectProjection) {
     }
 }
 
+// The paper's H_CPd = H_Cd H_CP H_Pd^-1, each lift from eq. 22 of its own device, is the homography through
+// the plane at height d that the calibration gives directly.
+TEST(Geometry, EquationTwentyTwoForBothDevicesComposesTheElevatedCameraProjectorMap) {
+    const Calibration calibration = test::paperLikeCalibration();
+    const Eigen::Matrix3d tableToCamera = calibration.tableToCameraHomography();
+    const Eigen::Matrix3d tableToProjector = calibration.tableToProjectorHomography();
+    const Eigen::Vector3d cameraP3 = calibration.cameraMatrix * calibration.tableToCamera.rotation().col(2);
+    const Eigen::Vector3d projectorP3 =
+        calibration.projectorMatrix * calibration.tableToProjector.rotation().col(2);
+    for (double height : {2.0, 10.0, 40.0}) {
+        const Eigen::Matrix3d composed =
+            elevatedPlaneHomography(tableToCamera, cameraP3, height) *
+            calibration.projectorToCameraHomography() *
+            elevatedPlaneHomography(tableToProjector, projectorP3, height).inverse();
+        for (const Eigen::Vector2d& projector :
+             {Eigen::Vector2d(40, 30), Eigen::Vector2d(320, 240), Eigen::Vector2d(600, 450)})
+            EXPECT_LT((applyHomography(composed, projector) -
+                       applyHomography(calibration.projectorToCameraHomography(height), projector))
+                          .norm(),
+                      1e-6)
+                << "height " << height;
+    }
+}
+
 TEST(Geometry, HomographyRoundTripIsIdentity) {
     const Calibration calibration = test::paperLikeCalibration();
     const Eigen::Vector2d camera(300.25, 211.5);
