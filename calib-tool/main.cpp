@@ -1,83 +1,223 @@
 // everytouch-calib: calibrates everytouchd and shows its status, over D-Bus.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
-#include <memory>
+#include <filesystem>
+#include <optional>
 #include <string>
 
-#include <systemd/sd-bus.h>
 #include <CLI/CLI.hpp>
 
+#include "daemon_client.h"
+#include "io/handles.h"
 #include "version.h"
 
 namespace {
 
-constexpr const char* kBusName = "org.everytouch.Daemon1";
-constexpr const char* kObjectPath = "/org/everytouch/Daemon1";
-constexpr const char* kInterface = "org.everytouch.Daemon1";
+using namespace everytouch;
+using calib::DaemonClient;
+using calib::Failure;
 
-// Exit codes, as documented in --help.
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitNotRunning = 3;
+int report(const Failure& failure) {
+    std::fprintf(stderr, "%s\n", failure.message.c_str());
+    return failure.exitStatus;
+}
 
-struct BusDeleter {
-    void operator()(sd_bus* bus) const { sd_bus_flush_close_unref(bus); }
-};
-using Bus = std::unique_ptr<sd_bus, BusDeleter>;
-
-struct ErrorGuard {
-    sd_bus_error error = SD_BUS_ERROR_NULL;
-    ~ErrorGuard() { sd_bus_error_free(&error); }
-};
-
-std::string readStringProperty(sd_bus* bus, const char* name, int& result) {
-    ErrorGuard guard;
-    char* value = nullptr;
-    result = sd_bus_get_property_string(bus, kBusName, kObjectPath, kInterface, name, &guard.error, &value);
-    std::string text = result >= 0 && value ? value : "";
-    std::free(value);
+template <typename T>
+std::string format(const char* pattern, T value) {
+    char text[64];
+    std::snprintf(text, sizeof text, pattern, value);
     return text;
 }
 
+// One line per property, in words.
+std::string describe(const std::string& name, const calib::PropertyValue& value) {
+    if (const auto* text = std::get_if<std::string>(&value))
+        return text->empty() && name == "DevicePath" ? "(none)" : *text;
+    if (const auto* flag = std::get_if<bool>(&value))
+        return *flag ? "yes" : "no";
+    if (const auto* number = std::get_if<double>(&value)) {
+        if (name == "FrameRate")
+            return format("%.1f frames/s", *number);
+        if (name == "LatencyMs")
+            return format("%.1f ms", *number);
+        return format("%.1f mm", *number);
+    }
+    if (const auto* count = std::get_if<std::uint64_t>(&value))
+        return std::to_string(*count) + " frames";
+    return std::to_string(std::get<std::uint32_t>(value));
+}
+
 int status() {
-    sd_bus* raw = nullptr;
-    int r = sd_bus_open_system(&raw);
-    Bus bus(raw);
-    if (r < 0) {
-        std::fprintf(stderr, "Cannot connect to the system bus: %s\n", std::strerror(-r));
-        return kExitFailure;
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    auto properties = std::get<DaemonClient>(client).allProperties();
+    if (auto* failure = std::get_if<Failure>(&properties))
+        return report(*failure);
+    const auto& values = std::get<0>(properties);
+    const std::pair<const char*, const char*> rows[] = {
+        {"State", "State"},           {"Rig", "Rig"},
+        {"Calibrated", "Calibrated"}, {"TouchHeightMm", "Touch height"},
+        {"FrameRate", "Frame rate"},  {"LatencyMs", "Latency"},
+        {"DroppedFrames", "Dropped"}, {"DevicePath", "Touch device"},
+    };
+    for (const auto& [property, label] : rows)
+        if (const auto it = values.find(property); it != values.end())
+            std::printf("%-14s %s\n", (std::string(label) + ":").c_str(),
+                        describe(property, it->second).c_str());
+    return calib::kExitOk;
+}
+
+int sensitivity(const std::optional<double>& heightMm) {
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    DaemonClient& daemon = std::get<DaemonClient>(client);
+    if (heightMm) {
+        if (auto failure = daemon.setTouchHeightMm(*heightMm))
+            return report(*failure);
+        std::printf("Fingers at or below %g mm above the table now touch.\n", *heightMm);
+        return calib::kExitOk;
     }
-    r = sd_bus_get_name_creds(bus.get(), kBusName, 0, nullptr);
-    if (r < 0) {
-        std::fprintf(stderr,
-                     "everytouchd is not running (no %s on the system bus). Start it with "
-                     "\"systemctl start everytouchd\".\n",
-                     kBusName);
-        return kExitNotRunning;
+    auto properties = daemon.allProperties();
+    if (auto* failure = std::get_if<Failure>(&properties))
+        return report(*failure);
+    const auto& values = std::get<0>(properties);
+    if (const auto it = values.find("TouchHeightMm"); it != values.end())
+        std::printf("%g\n", std::get<double>(it->second));
+    return calib::kExitOk;
+}
+
+int snapshot(const std::string& what, const std::filesystem::path& file) {
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    // The daemon writes into a temporary file beside the target, renamed once complete.
+    const std::filesystem::path directory = file.has_parent_path() ? file.parent_path() : ".";
+    std::string temporary = (directory / ("." + file.filename().string() + ".XXXXXX")).string();
+    io::UniqueFd fd(::mkostemp(temporary.data(), O_CLOEXEC));
+    if (!fd)
+        return report(
+            {calib::kExitFailure, "Cannot create " + file.string() + ": " + std::strerror(errno) + "."});
+    ::fchmod(fd.get(), 0644);
+    if (auto failure = std::get<DaemonClient>(client).snapshot(what, fd.get())) {
+        ::unlink(temporary.c_str());
+        return report(*failure);
     }
-    const std::string state = readStringProperty(bus.get(), "State", r);
-    if (r < 0) {
-        std::fprintf(stderr, "everytouchd did not report its state: %s\n", std::strerror(-r));
-        return kExitFailure;
+    if (::rename(temporary.c_str(), file.c_str()) < 0) {
+        const int error = errno;
+        ::unlink(temporary.c_str());
+        return report(
+            {calib::kExitFailure, "Cannot write " + file.string() + ": " + std::strerror(error) + "."});
     }
-    const std::string rig = readStringProperty(bus.get(), "Rig", r);
-    const std::string device = readStringProperty(bus.get(), "DevicePath", r);
-    std::printf("State:  %s\nRig:    %s\nDevice: %s\n", state.c_str(), rig.c_str(),
-                device.empty() ? "(none)" : device.c_str());
-    return kExitOk;
+    std::printf("Wrote the %s image to %s.\n", what.c_str(), file.c_str());
+    return calib::kExitOk;
+}
+
+// A bar on a terminal, plain lines elsewhere (logs, pipes).
+void showProgress(const std::string& step, double fraction, const std::string& message) {
+    const int percent = static_cast<int>(std::lround(100.0 * std::clamp(fraction, 0.0, 1.0)));
+    if (!::isatty(STDERR_FILENO)) {
+        std::fprintf(stderr, "%3d%% %s: %s\n", percent, step.c_str(), message.c_str());
+        return;
+    }
+    constexpr int kWidth = 30;
+    const int filled = percent * kWidth / 100;
+    std::fprintf(stderr, "\r\033[K[%s%s] %3d%% %s: %s", std::string(filled, '#').c_str(),
+                 std::string(kWidth - filled, '-').c_str(), percent, step.c_str(), message.c_str());
+    std::fflush(stderr);
+}
+
+int calibrate(const std::string& step, const DaemonClient::CalibrationOptions& options, bool save) {
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    DaemonClient& daemon = std::get<DaemonClient>(client);
+    auto outcome = daemon.calibrate(step, options, showProgress);
+    if (::isatty(STDERR_FILENO))
+        std::fprintf(stderr, "\n");
+    if (auto* failure = std::get_if<Failure>(&outcome))
+        return report(*failure);
+    const auto& result = std::get<DaemonClient::CalibrationResult>(outcome);
+    if (!result.ok)
+        return report({calib::kExitFailure,
+                       "Calibration failed: " + result.message + ". The previous calibration stays active."});
+    std::printf("Calibrated: RMS reprojection error %.2f px.\n", result.rmsPx);
+    if (!save)
+        return calib::kExitOk;
+    if (auto failure = daemon.saveCalibration())
+        return report(
+            {failure->exitStatus, "The new calibration is active but was not saved: " + failure->message});
+    std::printf("Saved; everytouchd uses it from now on, also after a restart.\n");
+    return calib::kExitOk;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
     CLI::App app{"everytouch-calib - calibrate everytouchd and show its status (talks to it over D-Bus)"};
-    app.set_version_flag("--version", std::string("everytouch-calib ") + everytouch::kVersion);
-    app.footer("Exit status: 0 success, 1 failure, 2 bad usage, 3 everytouchd is not running.");
+    app.set_version_flag("--version", std::string("everytouch-calib ") + kVersion);
+    app.footer(
+        "Exit status: 0 success; 1 the operation failed (the message says why); 2 bad usage or a value "
+        "everytouchd refused; 3 everytouchd is not running; 4 permission denied (root or the everytouch "
+        "group "
+        "is needed). See everytouch-calib(1).");
     app.require_subcommand(1);
-    CLI::App* statusCommand = app.add_subcommand("status", "Show the daemon's state, rig and touch device");
-    CLI11_PARSE(app, argc, argv);
+
+    CLI::App* statusCommand =
+        app.add_subcommand("status", "Show the daemon's state, rig, calibration and rates");
+
+    std::string step = "table";
+    DaemonClient::CalibrationOptions options;
+    bool noSave = false;
+    CLI::App* calibrateCommand = app.add_subcommand(
+        "calibrate",
+        "Calibrate: projector (projected chessboard), table (a card on the table) or full (both)");
+    calibrateCommand->add_option("step", step, "projector, table or full")
+        ->check(CLI::IsMember({"projector", "table", "full"}))
+        ->capture_default_str();
+    calibrateCommand->add_option("--frames", options.frames, "Frame pairs captured for each step (1-120)");
+    calibrateCommand->add_option("--card-width-mm", options.cardWidthMm,
+                                 "Width of the card the table step looks for (default 85.5)");
+    calibrateCommand->add_option("--card-height-mm", options.cardHeightMm,
+                                 "Height of the card the table step looks for (default 12.5)");
+    calibrateCommand->add_flag("--no-save", noSave,
+                               "Keep the new calibration only until everytouchd restarts");
+
+    std::optional<double> heightMm;
+    CLI::App* sensitivityCommand = app.add_subcommand(
+        "sensitivity",
+        "Show or set the touch height: a finger at most MM millimetres above the table touches");
+    sensitivityCommand->add_option("MM", heightMm, "The touch height in millimetres, 0 to 30");
+
+    std::string what;
+    std::filesystem::path file;
+    CLI::App* snapshotCommand = app.add_subcommand(
+        "snapshot", "Save what the camera sees as a PNG (needs root or the everytouch group)");
+    snapshotCommand->add_option("WHAT", what, "camera, texture or subtraction")->required();
+    snapshotCommand->add_option("FILE", file, "The PNG file to write")->required();
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        const int status = app.exit(error);
+        return status == 0 ? calib::kExitOk : calib::kExitUsage;
+    }
     if (statusCommand->parsed())
         return status();
-    return kExitFailure;
+    if (calibrateCommand->parsed())
+        return calibrate(step, options, !noSave);
+    if (sensitivityCommand->parsed())
+        return sensitivity(heightMm);
+    if (snapshotCommand->parsed())
+        return snapshot(what, file);
+    return calib::kExitUsage;
 }

@@ -2,6 +2,8 @@
 
 #include <libevdev/libevdev-uinput.h>
 #include <libevdev/libevdev.h>
+#include <systemd/sd-bus.h>
+#include <systemd/sd-event.h>
 #include <unistd.h>
 
 #include <memory>
@@ -25,6 +27,32 @@ using UniqueHandle = std::unique_ptr<T, HandleDeleter<releaseFunction>>;
 using UniqueLibevdev = UniqueHandle<libevdev, libevdev_free>;
 // Destroying it removes the uinput device and closes /dev/uinput.
 using UniqueLibevdevUinput = UniqueHandle<libevdev_uinput, libevdev_uinput_destroy>;
+
+// sd-bus and sd-event (libsystemd). A bus is flushed before it closes, so queued replies still go out.
+using Bus = UniqueHandle<sd_bus, sd_bus_flush_close_unref>;
+using BusMessage = UniqueHandle<sd_bus_message, sd_bus_message_unref>;
+using BusSlot = UniqueHandle<sd_bus_slot, sd_bus_slot_unref>;
+using BusCreds = UniqueHandle<sd_bus_creds, sd_bus_creds_unref>;
+using Event = UniqueHandle<sd_event, sd_event_unref>;
+using EventSource = UniqueHandle<sd_event_source, sd_event_source_disable_unref>;
+
+// Frees an sd_bus_error when it goes out of scope.
+class UniqueBusError {
+public:
+    UniqueBusError() = default;
+    UniqueBusError(const UniqueBusError&) = delete;
+    UniqueBusError& operator=(const UniqueBusError&) = delete;
+    ~UniqueBusError() { sd_bus_error_free(&error_); }
+
+    sd_bus_error* get() { return &error_; }
+    const sd_bus_error* get() const { return &error_; }
+    const char* name() const { return error_.name ? error_.name : ""; }
+    const char* message() const { return error_.message ? error_.message : ""; }
+    bool has(const char* name) const { return sd_bus_error_has_name(&error_, name); }
+
+private:
+    sd_bus_error error_ = SD_BUS_ERROR_NULL;
+};
 
 // Owns a file descriptor; closes it once.
 class UniqueFd {

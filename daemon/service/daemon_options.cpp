@@ -7,7 +7,8 @@ namespace everytouch::service {
 
 std::optional<std::string> DaemonOptions::validate() const {
     try {
-        io::RigSpec::parse(rig);
+        if (!rig.empty())
+            io::RigSpec::parse(rig);
     } catch (const io::InputError& error) {
         return error.what();
     }

@@ -1,47 +1,215 @@
 #include "service/frame_loop.h"
 
-#include <chrono>
+#include <cmath>
+#include <exception>
 
 namespace everytouch::service {
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The latency is smoothed with this time constant: long enough to be readable, short enough to follow a
+// pipeline that slows down.
+constexpr double kSmoothingSeconds = 1.0;
+// The pipeline thread wakes at least this often, so its heartbeat shows it is alive while no frame comes.
+constexpr std::chrono::milliseconds kPipelineWake{100};
+
+// The weight of one new sample when samples come at `perSecond`, so that a second's worth of them counts
+// as much as everything before.
+double smoothingWeight(double perSecond) {
+    return perSecond > 0.0 ? 1.0 - std::exp(-1.0 / (perSecond * kSmoothingSeconds)) : 1.0;
+}
+
+}  // namespace
+
 FrameLoop::FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks,
-                     io::RecordingWriter* recorder, std::uint64_t maxFrames)
-    : source_(source), sinks_(std::move(sinks)), recorder_(recorder), maxFrames_(maxFrames) {}
+                     io::RecordingWriter* recorder, LoopOptions options, PipelineSettings settings,
+                     std::function<void()> notify, SettingsHook onSettings)
+    : source_(source),
+      sinks_(std::move(sinks)),
+      recorder_(recorder),
+      options_(options),
+      notify_(std::move(notify)),
+      onSettings_(std::move(onSettings)),
+      queue_(options.queueCapacity, options.overflow),
+      settings_(std::move(settings)) {}
+
+FrameLoop::~FrameLoop() {
+    stop();
+}
+
+void FrameLoop::start() {
+    {
+        std::lock_guard lock(mutex_);
+        started_ = Clock::now();
+    }
+    heartbeatNs_ = Clock::now().time_since_epoch().count();
+    pipeline_ = std::thread([this] { runPipeline(); });
+    camera_ = std::thread([this] { runCamera(); });
+}
+
+void FrameLoop::stop() {
+    stopping_ = true;
+    queue_.close();
+    if (camera_.joinable())
+        camera_.join();
+    if (pipeline_.joinable())
+        pipeline_.join();
+}
+
+void FrameLoop::fail(const std::string& problem) {
+    std::lock_guard lock(mutex_);
+    if (!failure_)
+        failure_ = problem;
+}
+
+std::optional<std::string> FrameLoop::failure() const {
+    std::lock_guard lock(mutex_);
+    return failure_;
+}
+
+LoopStatistics FrameLoop::statistics() const {
+    std::lock_guard lock(mutex_);
+    LoopStatistics statistics = statistics_;
+    statistics.dropped = queue_.dropped();
+    statistics.frameRate = arrivals_.perSecond(Clock::now());
+    if (!finished_)
+        statistics.seconds = std::chrono::duration<double>(Clock::now() - started_).count();
+    return statistics;
+}
+
+core::Contacts FrameLoop::contacts(std::uint64_t& version) const {
+    std::lock_guard lock(mutex_);
+    version = contactsVersion_;
+    return contacts_;
+}
+
+std::chrono::steady_clock::time_point FrameLoop::heartbeat() const {
+    return Clock::time_point(Clock::duration(heartbeatNs_.load()));
+}
+
+void FrameLoop::setSettings(PipelineSettings settings) {
+    std::lock_guard lock(mutex_);
+    settings_ = std::move(settings);
+    ++settingsVersion_;
+}
+
+void FrameLoop::runCamera() {
+    while (!stopping_) {
+        {
+            std::lock_guard lock(mutex_);
+            if (options_.maxFrames != 0 && statistics_.frames >= options_.maxFrames)
+                break;
+        }
+        QueuedFrame item;
+        try {
+            std::optional<core::Frame> frame = source_.next();
+            if (!frame)
+                break;
+            item.frame = std::move(*frame);
+            if (recorder_) {
+                recorder_->addFrame(item.frame);
+                if (const auto truth = source_.truth())
+                    recorder_->addTruth(*truth);
+            }
+        } catch (const std::exception& error) {
+            fail(std::string("camera: ") + error.what());
+            break;
+        }
+        item.arrival = Clock::now();
+        {
+            std::lock_guard lock(mutex_);
+            arrivals_.add(item.arrival);
+            ++statistics_.frames;
+        }
+        if (!queue_.push(std::move(item)))
+            break;
+    }
+    if (recorder_) {
+        try {
+            recorder_->flush();
+        } catch (const std::exception& error) {
+            fail(std::string("recording: ") + error.what());
+        }
+    }
+    queue_.close();
+}
 
 void FrameLoop::publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts) {
     for (io::TouchSink* sink : sinks_)
         sink->publish(frameIndex, timestampUs, contacts);
-}
-
-LoopStatistics FrameLoop::run(const std::atomic<bool>& stop) {
-    LoopStatistics statistics;
-    const auto start = std::chrono::steady_clock::now();
-    std::uint64_t lastIndex = 0;
-    std::int64_t lastTimestampUs = 0;
-    const core::Contacts noContacts;
-    while (!stop && (maxFrames_ == 0 || statistics.frames < maxFrames_)) {
-        std::optional<core::Frame> frame = source_.next();
-        if (!frame)
-            break;
-        ++statistics.frames;
-        lastIndex = frame->index;
-        lastTimestampUs = frame->timestampUs;
-        if (recorder_) {
-            recorder_->addFrame(*frame);
-            if (const auto truth = source_.truth())
-                recorder_->addTruth(*truth);
-        }
-        if (std::optional<core::FramePair> pair = pairer_.push(*frame)) {
-            ++statistics.pairs;
-            // Detection stages plug in here; until they exist no finger is ever reported.
-            publish(frame->index, frame->timestampUs, noContacts);
+    bool changed = false;
+    {
+        std::lock_guard lock(mutex_);
+        if (contacts != contacts_) {
+            contacts_ = contacts;
+            ++contactsVersion_;
+            changed = true;
         }
     }
-    publish(lastIndex, lastTimestampUs, noContacts);
-    if (recorder_)
-        recorder_->flush();
-    statistics.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return statistics;
+    if (changed)
+        notify_();
+}
+
+void FrameLoop::runPipeline() {
+    QueuedFrame item;
+    std::uint64_t lastIndex = 0;
+    std::int64_t lastTimestampUs = 0;
+    PipelineSettings settings;
+    std::uint64_t settingsVersion = ~std::uint64_t{0};
+    const core::Contacts noContacts;
+    try {
+        while (!stopping_) {
+            const FrameQueue::PopResult result = queue_.pop(item, kPipelineWake);
+            heartbeatNs_ = Clock::now().time_since_epoch().count();
+            if (result == FrameQueue::PopResult::Closed)
+                break;
+            if (result == FrameQueue::PopResult::Timeout || stopping_)
+                continue;
+            lastIndex = item.frame.index;
+            lastTimestampUs = item.frame.timestampUs;
+            std::optional<core::FramePair> pair = pairer_.push(item.frame);
+            if (!pair)
+                continue;
+            bool newSettings = false;
+            {
+                std::lock_guard lock(mutex_);
+                ++statistics_.pairs;
+                if (settingsVersion != settingsVersion_) {
+                    settings = settings_;
+                    settingsVersion = settingsVersion_;
+                    newSettings = true;
+                }
+            }
+            if (newSettings && onSettings_)
+                onSettings_(settings);
+            tap_.offer(*pair);
+            // Detection stages plug in here: the contacts of `*pair` under `settings` (calibration, touch
+            // height). Until they exist no finger is ever reported.
+            publish(item.frame.index, item.frame.timestampUs, noContacts);
+            const double latencyS = std::chrono::duration<double>(Clock::now() - item.arrival).count();
+            std::lock_guard lock(mutex_);
+            const double weight =
+                statistics_.pairs == 1 ? 1.0 : smoothingWeight(arrivals_.perSecond(Clock::now()));
+            statistics_.latencyMs += weight * (1e3 * latencyS - statistics_.latencyMs);
+        }
+    } catch (const std::exception& error) {
+        fail(std::string("pipeline: ") + error.what());
+    }
+    try {
+        publish(lastIndex, lastTimestampUs, noContacts);
+    } catch (const std::exception& error) {
+        fail(std::string("releasing the contacts: ") + error.what());
+    }
+    {
+        std::lock_guard lock(mutex_);
+        statistics_.seconds = std::chrono::duration<double>(Clock::now() - started_).count();
+    }
+    finished_ = true;
+    // A failed pipeline stops the camera too; a finished stream has already closed the queue.
+    queue_.close();
+    notify_();
 }
 
 }  // namespace everytouch::service

@@ -1,40 +1,116 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
 #include <vector>
 
+#include "core/calibration.h"
+#include "core/contact.h"
 #include "core/frame_pairer.h"
 #include "io/frame_source.h"
 #include "io/recording.h"
 #include "io/touch_sink.h"
+#include "service/arrival_rate.h"
+#include "service/frame_queue.h"
+#include "service/frame_tap.h"
 
 namespace everytouch::service {
 
 struct LoopStatistics {
-    std::uint64_t frames = 0;  // camera frames taken from the source
-    std::uint64_t pairs = 0;   // frame pairs formed
-    double seconds = 0.0;      // wall-clock time of the run
+    std::uint64_t frames = 0;   // camera frames taken from the source
+    std::uint64_t pairs = 0;    // frame pairs formed
+    std::uint64_t dropped = 0;  // frames dropped because the pipeline fell behind the camera
+    double frameRate = 0.0;     // camera frames per second over the last second
+    double latencyMs = 0.0;  // from a frame's arrival to its contacts reaching the sinks, smoothed over ~1 s
+    double seconds = 0.0;    // wall-clock time since start, or of the whole run once finished
 };
 
-// Carries frames from a source through pairing and the pipeline stages to the sinks, in one thread.
+struct LoopOptions {
+    std::uint64_t maxFrames = 0;                                       // stop after N camera frames; 0: never
+    std::size_t queueCapacity = 4;                                     // frames waiting between the threads
+    FrameQueue::Overflow overflow = FrameQueue::Overflow::DropOldest;  // Block for sources that can wait
+};
+
+// What the pipeline stages need besides the frames; set from the main thread, read by the pipeline thread.
+struct PipelineSettings {
+    std::optional<core::Calibration> calibration;  // nothing while uncalibrated: no contacts can be found
+    double touchHeightMm = 0.0;                    // a finger at or below this height touches
+};
+
+// Runs on the pipeline thread when new settings take effect, before the next pair: the place for sinks that
+// depend on the calibration (the virtual touchscreen's size).
+using SettingsHook = std::function<void(const PipelineSettings&)>;
+
+// Carries frames from a source through pairing and the pipeline stages to the sinks: a camera thread reads
+// the source into a bounded queue, a pipeline thread pairs frames, runs the stages and publishes contacts.
+// The owner (the main thread) hears about news through `notify` and reads them here.
 class FrameLoop {
 public:
+    // `notify` runs on the loop's threads whenever the contacts change or the loop ends; it must be cheap and
+    // thread-safe.
     FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks, io::RecordingWriter* recorder,
-              std::uint64_t maxFrames);
+              LoopOptions options, PipelineSettings settings, std::function<void()> notify,
+              SettingsHook onSettings = nullptr);
+    ~FrameLoop();
+    FrameLoop(const FrameLoop&) = delete;
+    FrameLoop& operator=(const FrameLoop&) = delete;
 
-    // Runs until the source ends, `maxFrames` frames were taken or `stop` becomes true; then releases every
-    // contact.
-    LoopStatistics run(const std::atomic<bool>& stop);
+    void start();
+
+    // Stops both threads without waiting for the rest of the stream; every contact is released first.
+    void stop();
+
+    // Whether the loop ended: the stream ended, `maxFrames` were taken, or it failed.
+    bool finished() const { return finished_; }
+    // Why the loop failed (camera, recording, sink); nothing after a normal end.
+    std::optional<std::string> failure() const;
+
+    LoopStatistics statistics() const;
+    // The current contacts and a number that changes whenever they do.
+    core::Contacts contacts(std::uint64_t& version) const;
+    // The last time the pipeline thread showed it is alive (it wakes at least every 100 ms).
+    std::chrono::steady_clock::time_point heartbeat() const;
+
+    void setSettings(PipelineSettings settings);
+    FrameTap& tap() { return tap_; }
 
 private:
+    void runCamera();
+    void runPipeline();
     void publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts);
+    void fail(const std::string& problem);
 
     io::FrameSource& source_;
     std::vector<io::TouchSink*> sinks_;
     io::RecordingWriter* recorder_;
-    std::uint64_t maxFrames_;
-    core::FramePairer pairer_;
+    LoopOptions options_;
+    std::function<void()> notify_;
+    SettingsHook onSettings_;
+    FrameQueue queue_;
+    FrameTap tap_;
+    core::FramePairer pairer_;  // pipeline thread only
+
+    std::atomic<bool> stopping_{false};
+    std::atomic<bool> finished_{false};
+    std::atomic<std::int64_t> heartbeatNs_{0};
+    std::thread camera_;
+    std::thread pipeline_;
+
+    mutable std::mutex mutex_;  // guards everything below
+    LoopStatistics statistics_;
+    std::chrono::steady_clock::time_point started_;
+    ArrivalRate arrivals_;
+    core::Contacts contacts_;
+    std::uint64_t contactsVersion_ = 0;
+    std::optional<std::string> failure_;
+    PipelineSettings settings_;
+    std::uint64_t settingsVersion_ = 0;
 };
 
 }  // namespace everytouch::service

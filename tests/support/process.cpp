@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <thread>
@@ -64,7 +66,24 @@ ProcessResult runProcess(const std::vector<std::string>& argv) {
 }
 
 BackgroundProcess::BackgroundProcess(const std::vector<std::string>& argv,
-                                     const std::filesystem::path& outputFile) {
+                                     const std::filesystem::path& outputFile,
+                                     const std::vector<std::pair<std::string, std::string>>& environment)
+    : outputFile_(outputFile) {
+    std::vector<std::string> variables;
+    for (char** entry = environ; *entry; ++entry) {
+        const std::string variable = *entry;
+        bool replaced = false;
+        for (const auto& [name, value] : environment)
+            replaced = replaced || variable.starts_with(name + "=");
+        if (!replaced)
+            variables.push_back(variable);
+    }
+    for (const auto& [name, value] : environment)
+        variables.push_back(name + "=" + value);
+    std::vector<char*> envp;
+    for (std::string& variable : variables)
+        envp.push_back(variable.data());
+    envp.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, outputFile.c_str(),
@@ -75,7 +94,7 @@ BackgroundProcess::BackgroundProcess(const std::vector<std::string>& argv,
     for (const std::string& arg : argv)
         args.push_back(const_cast<char*>(arg.c_str()));
     args.push_back(nullptr);
-    const int spawned = posix_spawnp(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    const int spawned = posix_spawnp(&pid_, args[0], &actions, nullptr, args.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
     if (spawned != 0)
         throw std::system_error(spawned, std::generic_category(), "cannot start " + argv[0]);
@@ -105,6 +124,13 @@ bool BackgroundProcess::hasOpen(const std::filesystem::path& file) const {
 void BackgroundProcess::signal(int number) const {
     if (!exitCode_)
         kill(pid_, number);
+}
+
+std::string BackgroundProcess::output() const {
+    std::ifstream in(outputFile_);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
 }
 
 std::optional<int> BackgroundProcess::wait(std::chrono::milliseconds timeout) {

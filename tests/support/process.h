@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace everytouch::test {
@@ -24,7 +25,9 @@ ProcessResult runProcess(const std::vector<std::string>& argv);
 // Killed and reaped when the object goes, unless it ended before.
 class BackgroundProcess {
 public:
-    BackgroundProcess(const std::vector<std::string>& argv, const std::filesystem::path& outputFile);
+    // `environment`: variables set for the program on top of this process's environment.
+    BackgroundProcess(const std::vector<std::string>& argv, const std::filesystem::path& outputFile,
+                      const std::vector<std::pair<std::string, std::string>>& environment = {});
     ~BackgroundProcess();
     BackgroundProcess(const BackgroundProcess&) = delete;
     BackgroundProcess& operator=(const BackgroundProcess&) = delete;
@@ -35,8 +38,12 @@ public:
     void signal(int number) const;
     // The exit status (128 + signal number when killed), or nothing if it is still running after `timeout`.
     std::optional<int> wait(std::chrono::milliseconds timeout);
+    bool running() { return !wait(std::chrono::milliseconds(0)); }
+    // What it has written so far.
+    std::string output() const;
 
 private:
+    std::filesystem::path outputFile_;
     pid_t pid_ = -1;
     std::optional<int> exitCode_;
 };

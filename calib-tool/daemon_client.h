@@ -1,0 +1,69 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+
+#include <systemd/sd-bus.h>
+
+#include "io/handles.h"
+
+namespace everytouch::calib {
+
+// Exit statuses of everytouch-calib, as --help and everytouch-calib(1) list them.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitNotRunning = 3;
+inline constexpr int kExitDenied = 4;
+
+// Something the user must act on: the words to print and the exit status.
+struct Failure {
+    int exitStatus = kExitFailure;
+    std::string message;
+};
+
+using PropertyValue = std::variant<std::string, bool, double, std::uint32_t, std::uint64_t>;
+
+// A connection to everytouchd over the system bus. Every call returns a Failure phrased for the user, with
+// `action` ("Setting the touch height") naming what was attempted.
+class DaemonClient {
+public:
+    // Connects and checks that everytouchd is there.
+    static std::variant<DaemonClient, Failure> connect();
+
+    std::variant<std::map<std::string, PropertyValue>, Failure> allProperties();
+    std::optional<Failure> setTouchHeightMm(double heightMm);
+    std::optional<Failure> snapshot(const std::string& what, int fd);
+    std::optional<Failure> saveCalibration();
+
+    struct CalibrationOptions {
+        std::optional<std::uint32_t> frames;
+        std::optional<double> cardWidthMm;
+        std::optional<double> cardHeightMm;
+    };
+    using ProgressHandler =
+        std::function<void(const std::string& step, double fraction, const std::string& message)>;
+    struct CalibrationResult {
+        bool ok = false;
+        std::string message;
+        double rmsPx = 0.0;
+    };
+    // Starts a calibration and follows its signals until it finishes.
+    std::variant<CalibrationResult, Failure> calibrate(const std::string& step,
+                                                       const CalibrationOptions& options,
+                                                       const ProgressHandler& onProgress);
+
+private:
+    explicit DaemonClient(io::Bus bus) : bus_(std::move(bus)) {}
+
+    // Turns a failed call into words; `action` says what was attempted.
+    static Failure explain(const io::UniqueBusError& error, int r, const std::string& action);
+
+    io::Bus bus_;
+};
+
+}  // namespace everytouch::calib

@@ -1,0 +1,316 @@
+#include "service/bus_service.h"
+
+#include <cstring>
+#include <exception>
+
+#include "io/log.h"
+#include "service/bus_names.h"
+#include "service/daemon.h"
+
+namespace everytouch::service {
+
+namespace {
+
+BusService& serviceOf(void* userdata) {
+    return *static_cast<BusService*>(userdata);
+}
+
+// Runs a callback body; a BusError becomes its error reply, anything else a logged internal error.
+template <typename Body>
+int guarded(sd_bus_error* error, Body&& body) noexcept {
+    try {
+        return body();
+    } catch (const BusError& failure) {
+        return sd_bus_error_set(error, failure.name(), failure.what());
+    } catch (const std::exception& failure) {
+        ET_LOG(Error) << "internal error: " << failure.what();
+        return sd_bus_error_set(error, SD_BUS_ERROR_FAILED, failure.what());
+    } catch (...) {
+        return sd_bus_error_set(error, SD_BUS_ERROR_FAILED, "internal error");
+    }
+}
+
+void check(int r, const char* what) {
+    if (r < 0)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, std::string(what) + ": " + std::strerror(-r));
+}
+
+template <typename T>
+T readOption(sd_bus_message* message, const char* key, const char* type) {
+    const char* contents = nullptr;
+    check(sd_bus_message_peek_type(message, nullptr, &contents), "Calibrate options");
+    if (!contents || std::strcmp(contents, type) != 0)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, std::string("Calibrate option \"") + key +
+                                                      "\" must be of type " + type + ", not " +
+                                                      (contents ? contents : "?"));
+    T value{};
+    check(sd_bus_message_read(message, "v", type, &value), "Calibrate options");
+    return value;
+}
+
+CalibrationOptions readCalibrationOptions(sd_bus_message* message) {
+    CalibrationOptions options;
+    check(sd_bus_message_enter_container(message, 'a', "{sv}"), "Calibrate options");
+    int r = 0;
+    while ((r = sd_bus_message_enter_container(message, 'e', "sv")) > 0) {
+        const char* key = nullptr;
+        check(sd_bus_message_read(message, "s", &key), "Calibrate options");
+        if (std::strcmp(key, "frames") == 0)
+            options.pairsPerStep = readOption<std::uint32_t>(message, key, "u");
+        else if (std::strcmp(key, "card_width_mm") == 0)
+            options.cardWidthMm = readOption<double>(message, key, "d");
+        else if (std::strcmp(key, "card_height_mm") == 0)
+            options.cardHeightMm = readOption<double>(message, key, "d");
+        else
+            throw BusError(SD_BUS_ERROR_INVALID_ARGS,
+                           std::string("Unknown Calibrate option \"") + key +
+                               "\"; known: frames (u), card_width_mm (d), card_height_mm (d)");
+        check(sd_bus_message_exit_container(message), "Calibrate options");
+    }
+    check(r, "Calibrate options");
+    check(sd_bus_message_exit_container(message), "Calibrate options");
+    if (auto problem = options.validate())
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Calibrate option " + *problem);
+    return options;
+}
+
+int getApiVersion(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void*,
+                  sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "u", bus::kApiVersion);
+}
+
+int getState(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+             sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "s", toString(serviceOf(userdata).daemon().state()));
+}
+
+int getRig(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+           sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "s", serviceOf(userdata).daemon().rig().c_str());
+}
+
+int getCalibrated(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                  sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "b", static_cast<int>(serviceOf(userdata).daemon().calibrated()));
+}
+
+int getFrameRate(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                 sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().statistics().frameRate);
+}
+
+int getLatencyMs(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                 sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().statistics().latencyMs);
+}
+
+int getDroppedFrames(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                     sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "t", serviceOf(userdata).daemon().statistics().dropped);
+}
+
+int getTouchHeightMm(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                     sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().touchHeightMm());
+}
+
+int setTouchHeightMm(sd_bus* bus, const char*, const char*, const char*, sd_bus_message* value,
+                     void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(sd_bus_get_current_message(bus), "Setting TouchHeightMm");
+        double heightMm = 0.0;
+        check(sd_bus_message_read(value, "d", &heightMm), "TouchHeightMm");
+        service.daemon().setTouchHeightMm(heightMm);
+        return 0;
+    });
+}
+
+int getDevicePath(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                  sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "s", serviceOf(userdata).daemon().devicePath().c_str());
+}
+
+int methodCalibrate(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(message, "Calibrating");
+        const char* step = nullptr;
+        check(sd_bus_message_read(message, "s", &step), "Calibrate step");
+        const CalibrationOptions options = readCalibrationOptions(message);
+        service.daemon().calibrate(step, options);
+        return sd_bus_reply_method_return(message, nullptr);
+    });
+}
+
+int methodSaveCalibration(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(message, "Saving the calibration");
+        service.daemon().saveCalibration();
+        return sd_bus_reply_method_return(message, nullptr);
+    });
+}
+
+int methodResetCalibration(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(message, "Resetting the calibration");
+        service.daemon().resetCalibration();
+        return sd_bus_reply_method_return(message, nullptr);
+    });
+}
+
+int methodReloadConfig(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(message, "Reloading the configuration");
+        service.daemon().reloadConfig();
+        return sd_bus_reply_method_return(message, nullptr);
+    });
+}
+
+int methodSnapshot(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        // Camera images show whatever lies on the table and whoever sits at it.
+        service.requirePrivileged(message, "Taking a snapshot");
+        const char* what = nullptr;
+        int fd = -1;
+        check(sd_bus_message_read(message, "sh", &what, &fd), "Snapshot arguments");
+        service.daemon().snapshot(message, what, fd);
+        return 1;  // the reply follows once a frame pair has been written
+    });
+}
+
+const sd_bus_vtable kVtable[] = {
+    SD_BUS_VTABLE_START(0),
+    SD_BUS_PROPERTY("APIVersion", "u", getApiVersion, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY("State", "s", getState, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_PROPERTY("Rig", "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY("Calibrated", "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    // Statistics change with every frame: clients poll them instead of being flooded with signals.
+    SD_BUS_PROPERTY("FrameRate", "d", getFrameRate, 0, 0),
+    SD_BUS_PROPERTY("LatencyMs", "d", getLatencyMs, 0, 0),
+    SD_BUS_PROPERTY("DroppedFrames", "t", getDroppedFrames, 0, 0),
+    SD_BUS_WRITABLE_PROPERTY("TouchHeightMm", "d", getTouchHeightMm, setTouchHeightMm, 0,
+                             SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE | SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_PROPERTY("DevicePath", "s", getDevicePath, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_METHOD_WITH_ARGS("Calibrate", SD_BUS_ARGS("s", step, "a{sv}", options), SD_BUS_NO_RESULT,
+                            methodCalibrate, SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS("SaveCalibration", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodSaveCalibration,
+                            SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS("ResetCalibration", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodResetCalibration,
+                            SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS("ReloadConfig", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodReloadConfig,
+                            SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS("Snapshot", SD_BUS_ARGS("s", what, "h", fd), SD_BUS_NO_RESULT, methodSnapshot,
+                            SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_SIGNAL_WITH_ARGS("Contacts", SD_BUS_ARGS("a(uddbd)", contacts), 0),
+    SD_BUS_SIGNAL_WITH_ARGS("CalibrationProgress", SD_BUS_ARGS("s", step, "d", fraction, "s", message), 0),
+    SD_BUS_SIGNAL_WITH_ARGS("CalibrationFinished", SD_BUS_ARGS("b", ok, "s", message, "d", rms_px), 0),
+    SD_BUS_VTABLE_END,
+};
+
+}  // namespace
+
+BusService::BusService(Daemon& daemon) : daemon_(daemon), authorization_(bus::kPrivilegedGroup) {}
+
+int BusService::connect(sd_event* event, std::string& failedStep) {
+    sd_bus* bus = nullptr;
+    int r = sd_bus_open_system(&bus);
+    bus_.reset(bus);
+    if (r < 0) {
+        failedStep = "connect to the system bus";
+        return r;
+    }
+    // If the bus goes away, so does the daemon; systemd restarts it and it reconnects.
+    if ((r = sd_bus_set_exit_on_disconnect(bus_.get(), 1)) < 0 ||
+        (r = sd_bus_attach_event(bus_.get(), event, SD_EVENT_PRIORITY_NORMAL)) < 0) {
+        failedStep = "attach the bus to the event loop";
+        return r;
+    }
+    sd_bus_slot* slot = nullptr;
+    r = sd_bus_add_object_vtable(bus_.get(), &slot, bus::kObjectPath, bus::kInterface, kVtable, this);
+    objectSlot_.reset(slot);
+    if (r < 0) {
+        failedStep = "publish " + std::string(bus::kObjectPath);
+        return r;
+    }
+    if ((r = sd_bus_request_name(bus_.get(), bus::kBusName, 0)) < 0) {
+        failedStep = "own the bus name " + std::string(bus::kBusName);
+        return r;
+    }
+    if (!authorization_.groupExists())
+        ET_LOG(Notice) << "there is no group \"" << authorization_.groupName()
+                       << "\": only root may calibrate or change settings";
+    return 0;
+}
+
+void BusService::requirePrivileged(sd_bus_message* message, const char* action) const {
+    const int r = authorization_.check(message);
+    if (r < 0)
+        throw BusError(SD_BUS_ERROR_ACCESS_DENIED,
+                       std::string("Cannot check the caller's credentials: ") + std::strerror(-r));
+    if (r == 0)
+        throw BusError(SD_BUS_ERROR_ACCESS_DENIED, std::string(action) +
+                                                       " needs root or membership in the \"" +
+                                                       authorization_.groupName() + "\" group");
+}
+
+void BusService::propertiesChanged(const std::vector<const char*>& names) {
+    std::vector<char*> list;
+    for (const char* name : names)
+        list.push_back(const_cast<char*>(name));
+    list.push_back(nullptr);
+    const int r =
+        sd_bus_emit_properties_changed_strv(bus_.get(), bus::kObjectPath, bus::kInterface, list.data());
+    if (r < 0)
+        ET_LOG(Warning) << "cannot signal changed properties: " << std::strerror(-r);
+}
+
+void BusService::contacts(const core::Contacts& contacts) {
+    sd_bus_message* raw = nullptr;
+    int r = sd_bus_message_new_signal(bus_.get(), &raw, bus::kObjectPath, bus::kInterface, "Contacts");
+    const io::BusMessage signal(raw);
+    if (r >= 0)
+        r = sd_bus_message_open_container(signal.get(), 'a', "(uddbd)");
+    for (const core::Contact& contact : contacts)
+        if (r >= 0)
+            r = sd_bus_message_append(signal.get(), "(uddbd)", contact.id, contact.x, contact.y,
+                                      static_cast<int>(contact.touching), contact.heightMm);
+    if (r >= 0)
+        r = sd_bus_message_close_container(signal.get());
+    if (r >= 0)
+        r = sd_bus_send(bus_.get(), signal.get(), nullptr);
+    if (r < 0)
+        ET_LOG(Warning) << "cannot send the Contacts signal: " << std::strerror(-r);
+}
+
+void BusService::calibrationProgress(const std::string& step, double fraction, const std::string& message) {
+    const int r = sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, "CalibrationProgress",
+                                     "sds", step.c_str(), fraction, message.c_str());
+    if (r < 0)
+        ET_LOG(Warning) << "cannot send CalibrationProgress: " << std::strerror(-r);
+}
+
+void BusService::calibrationFinished(bool ok, const std::string& message, double rmsPx) {
+    const int r = sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, "CalibrationFinished",
+                                     "bsd", static_cast<int>(ok), message.c_str(), rmsPx);
+    if (r < 0)
+        ET_LOG(Warning) << "cannot send CalibrationFinished: " << std::strerror(-r);
+}
+
+void BusService::reply(sd_bus_message* call) {
+    const int r = sd_bus_reply_method_return(call, nullptr);
+    if (r < 0)
+        ET_LOG(Debug) << "cannot reply to " << sd_bus_message_get_sender(call) << ": " << std::strerror(-r);
+}
+
+void BusService::replyError(sd_bus_message* call, const char* name, const std::string& message) {
+    const int r = sd_bus_reply_method_errorf(call, name, "%s", message.c_str());
+    if (r < 0)
+        ET_LOG(Debug) << "cannot reply to " << sd_bus_message_get_sender(call) << ": " << std::strerror(-r);
+}
+
+}  // namespace everytouch::service

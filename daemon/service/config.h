@@ -1,0 +1,39 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace everytouch::service {
+
+// The range of TouchHeightMm: a finger whose pad is at most this high above the table touches it. Above 30 mm
+// a hovering hand would click; below 0 nothing would.
+inline constexpr double kMinTouchHeightMm = 0.0;
+inline constexpr double kMaxTouchHeightMm = 30.0;
+
+// The daemon's configuration file, everytouchd.conf (documented key by key in everytouchd(8) and in the
+// shipped example). Command-line options override it.
+struct DaemonConfig {
+    std::string rig;                        // [Camera] Rig=: a --rig spec; empty when no camera is configured
+    double touchHeightMm = 3.0;             // [Touch] HeightMm=: touching at or below this height, mm
+    std::optional<bool> uinput;             // [Output] Uinput=: virtual touchscreen; unset: only for cameras
+    std::filesystem::path calibrationPath;  // [Calibration] Path=: calibration store; empty: not configured
+
+    bool operator==(const DaemonConfig&) const = default;
+};
+
+// Reads `mainFile`, then every *.conf file in the directory `mainFile` + ".d" in lexical order; a later
+// assignment replaces an earlier one and an empty value restores the default. A missing main file is fine
+// unless `mustExist`. Throws io::InputError "FILE:LINE: [Section] Key: problem" for the first unknown key,
+// bad value or malformed line.
+DaemonConfig loadConfig(const std::filesystem::path& mainFile, bool mustExist);
+
+// Every key the configuration file knows: section and key.
+std::vector<std::pair<std::string, std::string>> configKeys();
+
+// The drop-in directory of a main configuration file.
+std::filesystem::path dropInDirectory(const std::filesystem::path& mainFile);
+
+}  // namespace everytouch::service

@@ -1,0 +1,645 @@
+#include "service/daemon.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <systemd/sd-daemon.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <mutex>
+#include <system_error>
+
+#include "io/input_error.h"
+#include "io/log.h"
+#include "service/bus_names.h"
+#include "service/bus_service.h"
+#include "service/frame_sources.h"
+#include "version.h"
+
+namespace everytouch::service {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Frames waiting between the camera and the pipeline thread: enough to ride out a slow pair, few enough
+// that a late pipeline works on fresh frames.
+constexpr std::size_t kQueueFrames = 4;
+// Contacts signals at most this often: enough for a tool that draws them, far below the camera rate.
+constexpr auto kContactsSignalInterval = std::chrono::milliseconds(33);
+constexpr std::uint64_t kStatusIntervalUsec = 5'000'000;
+// How long a Snapshot waits for a frame pair before it reports that the camera delivers none.
+constexpr std::uint64_t kSnapshotTimeoutUsec = 3'000'000;
+// How long a Snapshot waits for the receiving end of its descriptor to take the PNG.
+constexpr std::chrono::milliseconds kSnapshotWriteTimeout{3000};
+
+// How long a calibration step waits for its frame pairs: a fixed allowance plus a generous time per pair.
+std::chrono::milliseconds captureTimeout(std::size_t pairs) {
+    return std::chrono::milliseconds(5000 + 100 * static_cast<long>(pairs));
+}
+
+std::string formatDouble(const char* format, double value) {
+    char text[64];
+    std::snprintf(text, sizeof text, format, value);
+    return text;
+}
+
+}  // namespace
+
+const char* toString(DaemonState state) {
+    switch (state) {
+        case DaemonState::Starting:
+            return "starting";
+        case DaemonState::Running:
+            return "running";
+        case DaemonState::Calibrating:
+            return "calibrating";
+        case DaemonState::Degraded:
+            return "degraded";
+        case DaemonState::Failed:
+            return "failed";
+    }
+    return "failed";
+}
+
+Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
+
+Daemon::~Daemon() {
+    shutDown();
+}
+
+void Daemon::prepareSignals() {
+    sigset_t signals;
+    sigemptyset(&signals);
+    for (int signal : {SIGTERM, SIGINT, SIGHUP})
+        sigaddset(&signals, signal);
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::signal(SIGPIPE, SIG_IGN);
+}
+
+int Daemon::run() {
+    config_ = loadConfig(options_.configPath, options_.configPath != kDefaultConfigPath);
+    touchHeightMm_ = config_.touchHeightMm;
+
+    std::string rigText = !options_.rig.empty() ? options_.rig : config_.rig;
+    if (rigText.empty() && options_.service) {
+        const std::string problem = "No camera configured: set [Camera] Rig= in " +
+                                    options_.configPath.string() + " (see everytouchd(8))";
+        ET_LOG(Error) << problem;
+        sd_notifyf(0, "STATUS=%s", problem.c_str());
+        return kExitNotConfigured;
+    }
+    if (rigText.empty())
+        rigText = kHandRunRig;
+    const io::RigSpec spec = io::RigSpec::parse(rigText);
+    rigName_ = spec.toString();
+    cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
+    source_ = openFrameSource(spec, options_.fast);
+    ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe();
+    const std::optional<io::RigDescription> rig = source_->rig();
+
+    loadCalibration(rig);
+
+    if (!options_.recordDir.empty()) {
+        if (!rig)
+            throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
+        recorder_ = std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, source_->truth().has_value());
+    }
+    if (const int r = startEventLoop(); r < 0)
+        throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
+    connectBus();
+    startFrameLoop(openOutputs());
+    startWatchdog();
+
+    ready_ = true;
+    reportedCalibrated_ = calibrated();
+    refreshState();
+    sd_notify(0, "READY=1");
+    notifyStatus();
+
+    const int r = sd_event_loop(event_.get());
+    if (r < 0) {
+        ET_LOG(Error) << "the event loop failed: " << std::strerror(-r);
+        exitStatus_ = kExitFailure;
+    } else if (r != kExitSuccess) {
+        exitStatus_ = r;
+    }
+    shutDown();
+    return exitStatus_;
+}
+
+void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
+    std::filesystem::path storePath = config_.calibrationPath;
+    if (storePath.empty() && cameraRig_)
+        storePath = kDefaultCalibrationPath;
+    store_.emplace(storePath, rig ? std::optional(rig->calibration) : std::nullopt);
+    if (const std::optional<std::string> problem = store_->load())
+        ET_LOG(Error) << *problem
+                      << "; running uncalibrated, and the file stays as it is until a new calibration "
+                      << "is saved";
+    else if (!store_->active())
+        ET_LOG(Notice) << "not calibrated yet: run \"everytouch-calib calibrate\"";
+    else
+        ET_LOG(Info) << "calibration from "
+                     << (store_->keepsFile() ? store_->path().string() : std::string("the rig itself"));
+}
+
+std::vector<io::TouchSink*> Daemon::openOutputs() {
+    std::vector<io::TouchSink*> sinks;
+    // A person at the terminal sees the touches; the journal of a service would only fill up with them.
+    if (!options_.service) {
+        console_ = std::make_unique<io::ConsoleSink>();
+        sinks.push_back(console_.get());
+    }
+    if (!options_.touchLog.empty()) {
+        touchLog_ = std::make_unique<io::TouchLogWriter>(options_.touchLog);
+        sinks.push_back(touchLog_.get());
+    }
+    const bool uinputAsked = std::ranges::find(options_.outputs, "uinput") != options_.outputs.end();
+    if (uinputAsked || config_.uinput.value_or(cameraRig_)) {
+        touchscreen_ = std::make_unique<TouchscreenOutput>([this](const std::string& devnode) {
+            inbox_.post([this, devnode] {
+                devicePath_ = devnode;
+                if (bus_)
+                    bus_->propertiesChanged({"DevicePath"});
+            });
+        });
+        if (store_->active())
+            touchscreen_->applyCalibration(*store_->active());
+        else
+            ET_LOG(Notice)
+                << "the virtual touchscreen appears once everytouchd is calibrated: its size comes from "
+                   "the calibration";
+        sinks.push_back(touchscreen_.get());
+    }
+    return sinks;
+}
+
+void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
+    LoopOptions loopOptions;
+    loopOptions.maxFrames = options_.maxFrames;
+    loopOptions.queueCapacity = kQueueFrames;
+    // Sim and replay running fast can wait for the pipeline; a paced stream behaves like a camera.
+    loopOptions.overflow = options_.fast ? FrameQueue::Overflow::Block : FrameQueue::Overflow::DropOldest;
+    loop_ = std::make_unique<FrameLoop>(
+        *source_, std::move(sinks), recorder_.get(), loopOptions,
+        PipelineSettings{store_->active(), touchHeightMm_}, [this] { inbox_.post([this] { onLoopNews(); }); },
+        [this](const PipelineSettings& settings) {
+            if (!touchscreen_ || !settings.calibration)
+                return;
+            try {
+                touchscreen_->applyCalibration(*settings.calibration);
+            } catch (const std::exception& error) {
+                ET_LOG(Error) << "virtual touchscreen: " << error.what() << "; it keeps its previous size";
+            }
+        });
+    loop_->start();
+}
+
+int Daemon::startEventLoop() {
+    sd_event* event = nullptr;
+    int r = sd_event_default(&event);
+    event_.reset(event);
+    if (r < 0)
+        return r;
+    const std::pair<int, sd_event_signal_handler_t> handlers[] = {
+        {SIGTERM, onStopSignal}, {SIGINT, onStopSignal}, {SIGHUP, onReloadSignal}};
+    for (const auto& [signal, handler] : handlers) {
+        sd_event_source* source = nullptr;
+        r = sd_event_add_signal(event_.get(), &source, signal, handler, this);
+        if (r < 0)
+            return r;
+        eventSources_.emplace_back(source);
+    }
+    if ((r = inbox_.attach(event_.get())) < 0)
+        return r;
+    sd_event_source* source = nullptr;
+    r = sd_event_add_time_relative(event_.get(), &source, CLOCK_MONOTONIC, kStatusIntervalUsec, 0,
+                                   onStatusTimer, this);
+    if (r < 0)
+        return r;
+    eventSources_.emplace_back(source);
+    r = sd_event_add_time_relative(event_.get(), &source, CLOCK_MONOTONIC, 0, 0, onContactsTimer, this);
+    if (r < 0)
+        return r;
+    contactsTimer_.reset(source);
+    return sd_event_source_set_enabled(source, SD_EVENT_OFF);
+}
+
+void Daemon::connectBus() {
+    bus_ = std::make_unique<BusService>(*this);
+    std::string failedStep;
+    const int r = bus_->connect(event_.get(), failedStep);
+    if (r >= 0) {
+        ET_LOG(Info) << "on the system bus as " << bus::kBusName;
+        return;
+    }
+    bus_.reset();
+    const std::string problem = "cannot " + failedStep + ": " + std::strerror(-r);
+    if (options_.service)
+        throw std::runtime_error(problem);
+    ET_LOG(Notice) << problem << "; running without the D-Bus interface";
+}
+
+void Daemon::startWatchdog() {
+    if (sd_watchdog_enabled(0, &watchdogUsec_) <= 0)
+        return;
+    sd_event_source* source = nullptr;
+    if (sd_event_add_time_relative(event_.get(), &source, CLOCK_MONOTONIC, watchdogUsec_ / 2, 0, onWatchdog,
+                                   this) >= 0)
+        eventSources_.emplace_back(source);
+}
+
+DaemonState Daemon::state() const {
+    if (!ready_)
+        return DaemonState::Starting;
+    if (loop_ && loop_->failure())
+        return DaemonState::Failed;
+    if (calibration_)
+        return DaemonState::Calibrating;
+    if (!calibrated())
+        return DaemonState::Degraded;
+    return DaemonState::Running;
+}
+
+LoopStatistics Daemon::statistics() const {
+    return loop_ ? loop_->statistics() : LoopStatistics{};
+}
+
+void Daemon::refreshState() {
+    if (!ready_)
+        return;
+    std::vector<const char*> changed;
+    if (const DaemonState now = state(); now != reportedState_) {
+        reportedState_ = now;
+        changed.push_back("State");
+    }
+    if (const bool now = calibrated(); now != reportedCalibrated_) {
+        reportedCalibrated_ = now;
+        changed.push_back("Calibrated");
+    }
+    if (changed.empty())
+        return;
+    if (bus_)
+        bus_->propertiesChanged(changed);
+    notifyStatus();
+}
+
+void Daemon::notifyStatus() {
+    std::string status;
+    switch (state()) {
+        case DaemonState::Starting:
+            status = "Starting";
+            break;
+        case DaemonState::Running:
+        case DaemonState::Degraded: {
+            const LoopStatistics statistics = loop_->statistics();
+            status = (calibrated() ? "Running on " : "Not calibrated (run everytouch-calib calibrate), on ") +
+                     rigName_ + ": " + formatDouble("%.1f", statistics.frameRate) + " frames/s, " +
+                     std::to_string(statistics.dropped) + " dropped";
+            break;
+        }
+        case DaemonState::Calibrating:
+            status = "Calibrating";
+            break;
+        case DaemonState::Failed:
+            status = "Failed: " + loop_->failure().value_or("");
+            break;
+    }
+    sd_notifyf(0, "STATUS=%s", status.c_str());
+}
+
+void Daemon::applySettings() {
+    if (loop_)
+        loop_->setSettings(PipelineSettings{store_->active(), touchHeightMm_});
+}
+
+void Daemon::onLoopNews() {
+    if (loop_->finished()) {
+        if (const std::optional<std::string> failure = loop_->failure()) {
+            ET_LOG(Error) << *failure;
+            exitStatus_ = kExitFailure;
+            refreshState();
+        }
+        sd_event_exit(event_.get(), exitStatus_);
+        return;
+    }
+    emitContacts();
+}
+
+void Daemon::emitContacts() {
+    if (!bus_)
+        return;
+    std::uint64_t version = 0;
+    const core::Contacts contacts = loop_->contacts(version);
+    if (version == contactsVersion_)
+        return;
+    const Clock::time_point now = Clock::now();
+    if (now - lastContactsSignal_ < kContactsSignalInterval) {
+        const auto due = std::chrono::duration_cast<std::chrono::microseconds>(lastContactsSignal_ +
+                                                                               kContactsSignalInterval - now);
+        sd_event_source_set_time_relative(contactsTimer_.get(), static_cast<std::uint64_t>(due.count()));
+        sd_event_source_set_enabled(contactsTimer_.get(), SD_EVENT_ONESHOT);
+        return;
+    }
+    contactsVersion_ = version;
+    lastContactsSignal_ = now;
+    bus_->contacts(contacts);
+}
+
+void Daemon::setTouchHeightMm(double heightMm) {
+    if (!std::isfinite(heightMm) || heightMm < kMinTouchHeightMm || heightMm > kMaxTouchHeightMm)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "TouchHeightMm must be from " +
+                                                      formatDouble("%g", kMinTouchHeightMm) + " to " +
+                                                      formatDouble("%g", kMaxTouchHeightMm) + " mm, not " +
+                                                      formatDouble("%g", heightMm));
+    if (heightMm == touchHeightMm_)
+        return;
+    touchHeightMm_ = heightMm;
+    applySettings();
+    if (bus_)
+        bus_->propertiesChanged({"TouchHeightMm"});
+    ET_LOG(Info) << "touch height set to " << heightMm << " mm";
+}
+
+void Daemon::calibrate(std::string_view request, const CalibrationOptions& options) {
+    std::optional<std::vector<CalibrationStep>> steps = calibrationSteps(request);
+    if (!steps)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Unknown calibration step \"" + std::string(request) +
+                                                      "\"; expected " + kCalibrationRequests);
+    if (calibration_)
+        throw BusError(bus::kErrorBusy,
+                       "A calibration is already running; wait for its CalibrationFinished signal");
+    if (loop_->finished())
+        throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
+    if (const std::optional<std::string> missing = missingEstimator(*steps))
+        throw BusError(bus::kErrorCalibrationFailed, *missing + "; the current calibration stays active");
+
+    calibration_ = std::make_unique<CalibrationRun>();
+    CalibrationRun* run = calibration_.get();
+    run->thread = std::thread([this, run, steps = std::move(*steps), options, start = store_->active()] {
+        const CaptureFunction capture = [this, run](std::size_t pairs) {
+            struct Handover {
+                std::mutex mutex;
+                std::condition_variable arrived;
+                std::optional<std::vector<core::FramePair>> pairs;
+            };
+            auto handover = std::make_shared<Handover>();
+            const FrameTap::Ticket ticket =
+                loop_->tap().request(pairs, [handover](std::vector<core::FramePair>&& captured) {
+                    std::lock_guard lock(handover->mutex);
+                    handover->pairs = std::move(captured);
+                    handover->arrived.notify_all();
+                });
+            const auto deadline = Clock::now() + captureTimeout(pairs);
+            std::unique_lock lock(handover->mutex);
+            while (!handover->pairs && !run->cancelled && Clock::now() < deadline)
+                handover->arrived.wait_for(lock, std::chrono::milliseconds(100));
+            if (!handover->pairs)
+                loop_->tap().cancel(ticket);
+            return std::move(handover->pairs);
+        };
+        const ProgressFunction progress = [this](const std::string& step, double fraction,
+                                                 const std::string& message) {
+            inbox_.post([this, step, fraction, message] {
+                if (bus_)
+                    bus_->calibrationProgress(step, fraction, message);
+            });
+        };
+        CalibrationOutcome outcome;
+        try {
+            outcome = runCalibration(steps, options, start, capture, progress);
+        } catch (const std::exception& error) {
+            outcome.message = error.what();
+        }
+        inbox_.post([this, outcome] { finishCalibration(outcome); });
+    });
+    refreshState();
+}
+
+void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
+    if (!calibration_)
+        return;
+    calibration_->thread.join();
+    calibration_.reset();
+    if (outcome.ok) {
+        store_->activate(*outcome.calibration);
+        applySettings();
+        ET_LOG(Notice) << outcome.message << "; SaveCalibration keeps it";
+    } else {
+        ET_LOG(Warning) << "calibration failed: " << outcome.message
+                        << "; the previous calibration stays active";
+    }
+    if (bus_)
+        bus_->calibrationFinished(outcome.ok, outcome.message, outcome.rmsPx);
+    refreshState();
+}
+
+void Daemon::saveCalibration() {
+    if (!store_->keepsFile())
+        throw BusError(SD_BUS_ERROR_NOT_SUPPORTED,
+                       "This rig uses its own calibration and no calibration file is configured; set "
+                       "[Calibration] Path= in " +
+                           options_.configPath.string() + " to keep one");
+    if (!store_->active())
+        throw BusError(bus::kErrorNotCalibrated, "There is no calibration to save; calibrate first");
+    try {
+        store_->save();
+    } catch (const std::exception& error) {
+        throw BusError(SD_BUS_ERROR_FAILED, std::string("Cannot save the calibration: ") + error.what());
+    }
+    ET_LOG(Notice) << "calibration saved to " << store_->path().string();
+}
+
+void Daemon::resetCalibration() {
+    if (calibration_)
+        throw BusError(bus::kErrorBusy, "A calibration is running; wait for its CalibrationFinished signal");
+    store_->forget();
+    applySettings();
+    ET_LOG(Notice) << "calibration forgotten; the stored file, if any, is left as it is";
+    refreshState();
+}
+
+void Daemon::reloadConfig() {
+    DaemonConfig fresh;
+    try {
+        fresh = loadConfig(options_.configPath, options_.configPath != kDefaultConfigPath);
+    } catch (const std::exception& error) {
+        const std::string problem = std::string(error.what()) + "; the running configuration stays in effect";
+        ET_LOG(Error) << problem;
+        throw BusError(bus::kErrorInvalidConfig, problem);
+    }
+    // Only what the files changed is applied, so a reload keeps a touch height set over the bus.
+    if (fresh.touchHeightMm != config_.touchHeightMm)
+        setTouchHeightMm(fresh.touchHeightMm);
+    const std::pair<bool, const char*> restartOnly[] = {
+        {options_.rig.empty() && fresh.rig != config_.rig, "[Camera] Rig"},
+        {fresh.uinput != config_.uinput, "[Output] Uinput"},
+        {fresh.calibrationPath != config_.calibrationPath, "[Calibration] Path"},
+    };
+    for (const auto& [changed, key] : restartOnly)
+        if (changed)
+            ET_LOG(Notice) << key << " changed: it takes effect when everytouchd restarts";
+    config_ = fresh;
+    ET_LOG(Info) << "configuration reloaded from " << options_.configPath.string();
+}
+
+void Daemon::snapshot(sd_bus_message* call, std::string_view what, int fd) {
+    const std::optional<SnapshotKind> kind = parseSnapshotKind(what);
+    if (!kind && snapshotNeedsDetection(what))
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS,
+                       "Snapshot \"" + std::string(what) +
+                           "\" is not available yet: touch detection is not part of "
+                           "this build");
+    if (!kind)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Unknown snapshot \"" + std::string(what) +
+                                                      "\"; expected " + kSnapshotKinds + " (later also " +
+                                                      kSnapshotKindsNeedingDetection + ")");
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0 || (flags & O_ACCMODE) == O_RDONLY)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "The file descriptor is not open for writing");
+    if (loop_->finished())
+        throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
+    io::UniqueFd copy(::fcntl(fd, F_DUPFD_CLOEXEC, 3));
+    if (!copy)
+        throw BusError(SD_BUS_ERROR_FAILED,
+                       std::string("Cannot keep the file descriptor: ") + std::strerror(errno));
+
+    const std::uint64_t id = nextSnapshotId_++;
+    PendingSnapshot& pending = snapshots_[id];
+    pending.daemon = this;
+    pending.id = id;
+    pending.call.reset(sd_bus_message_ref(call));
+    pending.fd = std::move(copy);
+    pending.kind = *kind;
+    sd_event_source* timeout = nullptr;
+    if (const int r = sd_event_add_time_relative(event_.get(), &timeout, CLOCK_MONOTONIC,
+                                                 kSnapshotTimeoutUsec, 0, onSnapshotTimeout, &pending);
+        r < 0) {
+        snapshots_.erase(id);
+        throw BusError(SD_BUS_ERROR_FAILED, std::string("Cannot set a timeout: ") + std::strerror(-r));
+    }
+    pending.timeout.reset(timeout);
+    pending.ticket = loop_->tap().request(1, [this, id](std::vector<core::FramePair>&& pairs) {
+        inbox_.post([this, id, pair = std::move(pairs.front())] { completeSnapshot(id, pair); });
+    });
+}
+
+void Daemon::completeSnapshot(std::uint64_t id, const core::FramePair& pair) {
+    const auto it = snapshots_.find(id);
+    if (it == snapshots_.end())
+        return;
+    cv::Mat image;
+    renderSnapshot(it->second.kind, pair, image);
+    const int r = writeAllWithin(it->second.fd.get(), encodePng(image), kSnapshotWriteTimeout);
+    if (r < 0) {
+        failSnapshot(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-r));
+        return;
+    }
+    if (bus_)
+        bus_->reply(it->second.call.get());
+    snapshots_.erase(it);
+}
+
+void Daemon::failSnapshot(std::uint64_t id, const char* errorName, const std::string& message) {
+    const auto it = snapshots_.find(id);
+    if (it == snapshots_.end())
+        return;
+    if (loop_)
+        loop_->tap().cancel(it->second.ticket);
+    if (bus_)
+        bus_->replyError(it->second.call.get(), errorName, message);
+    snapshots_.erase(it);
+}
+
+void Daemon::shutDown() {
+    if (!loop_)
+        return;
+    sd_notify(0, "STOPPING=1");
+    if (calibration_) {
+        calibration_->cancelled = true;
+        calibration_->thread.join();
+        calibration_.reset();
+    }
+    loop_->stop();
+    while (!snapshots_.empty())
+        failSnapshot(snapshots_.begin()->first, bus::kErrorNoCamera, "everytouchd is stopping");
+    bus_.reset();
+    const LoopStatistics statistics = loop_->statistics();
+    ET_LOG(Info) << "processed " << statistics.frames << " frames (" << statistics.pairs << " pairs) in "
+                 << formatDouble("%.2f", statistics.seconds) << " s, " << statistics.dropped
+                 << " dropped; all contacts released";
+    ET_LOG(Notice) << "touch detection is not part of this build yet: frames are paired and recorded, no "
+                      "contacts are reported";
+    loop_.reset();
+}
+
+int Daemon::onStopSignal(sd_event_source* source, const struct signalfd_siginfo* info,
+                         void* userdata) noexcept {
+    auto* daemon = static_cast<Daemon*>(userdata);
+    ET_LOG(Info) << "stopping on " << sigabbrev_np(static_cast<int>(info->ssi_signo));
+    return sd_event_exit(sd_event_source_get_event(source), daemon->exitStatus_);
+}
+
+int Daemon::onReloadSignal(sd_event_source*, const struct signalfd_siginfo*, void* userdata) noexcept {
+    try {
+        static_cast<Daemon*>(userdata)->reloadConfig();
+    } catch (const BusError&) {
+        // reloadConfig() has logged why the files were rejected.
+    } catch (const std::exception& error) {
+        ET_LOG(Error) << "internal error: " << error.what();
+    }
+    return 0;
+}
+
+int Daemon::onWatchdog(sd_event_source* source, uint64_t, void* userdata) noexcept {
+    auto* daemon = static_cast<Daemon*>(userdata);
+    const auto silent = Clock::now() - daemon->loop_->heartbeat();
+    if (silent < std::chrono::microseconds(daemon->watchdogUsec_)) {
+        sd_notify(0, "WATCHDOG=1");
+        daemon->watchdogWarned_ = false;
+    } else if (!daemon->watchdogWarned_) {
+        ET_LOG(Warning) << "the pipeline thread has stalled; no longer telling the watchdog that all is well";
+        daemon->watchdogWarned_ = true;
+    }
+    sd_event_source_set_time_relative(source, daemon->watchdogUsec_ / 2);
+    return sd_event_source_set_enabled(source, SD_EVENT_ONESHOT);
+}
+
+int Daemon::onStatusTimer(sd_event_source* source, uint64_t, void* userdata) noexcept {
+    try {
+        static_cast<Daemon*>(userdata)->notifyStatus();
+    } catch (const std::exception& error) {
+        ET_LOG(Error) << "internal error: " << error.what();
+    }
+    sd_event_source_set_time_relative(source, kStatusIntervalUsec);
+    return sd_event_source_set_enabled(source, SD_EVENT_ONESHOT);
+}
+
+int Daemon::onContactsTimer(sd_event_source*, uint64_t, void* userdata) noexcept {
+    try {
+        static_cast<Daemon*>(userdata)->emitContacts();
+    } catch (const std::exception& error) {
+        ET_LOG(Error) << "internal error: " << error.what();
+    }
+    return 0;
+}
+
+int Daemon::onSnapshotTimeout(sd_event_source*, uint64_t, void* userdata) noexcept {
+    auto* pending = static_cast<PendingSnapshot*>(userdata);
+    try {
+        pending->daemon->failSnapshot(
+            pending->id, bus::kErrorNoCamera,
+            "No camera frame pair arrived within " + std::to_string(kSnapshotTimeoutUsec / 1'000'000) + " s");
+    } catch (const std::exception& error) {
+        ET_LOG(Error) << "internal error: " << error.what();
+    }
+    return 0;
+}
+
+}  // namespace everytouch::service

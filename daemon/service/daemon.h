@@ -1,0 +1,169 @@
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "io/console_sink.h"
+#include "io/frame_source.h"
+#include "io/handles.h"
+#include "io/recording.h"
+#include "io/rig_spec.h"
+#include "io/touch_log.h"
+#include "service/calibration_job.h"
+#include "service/calibration_store.h"
+#include "service/config.h"
+#include "service/daemon_options.h"
+#include "service/frame_loop.h"
+#include "service/main_loop_inbox.h"
+#include "service/snapshot.h"
+#include "service/touchscreen_output.h"
+
+namespace everytouch::service {
+
+class BusService;
+
+// Exit statuses of everytouchd (its --help and everytouchd(8) list them).
+inline constexpr int kExitSuccess = 0;
+inline constexpr int kExitFailure = 1;        // the camera, the pipeline or a sink failed while running
+inline constexpr int kExitBadInput = 2;       // an option, the configuration, the rig or a file is wrong
+inline constexpr int kExitNotConfigured = 6;  // a service without a camera (LSB: "program is not configured")
+
+enum class DaemonState {
+    Starting,     // until the frames flow
+    Running,      // calibrated, detecting touches
+    Calibrating,  // a Calibrate job runs
+    Degraded,     // running without a usable calibration: no touches
+    Failed,       // the camera or the pipeline failed; the daemon is about to exit
+};
+const char* toString(DaemonState state);
+
+// What the bus-facing operations throw; the bus turns it into an error reply with this name.
+class BusError : public std::runtime_error {
+public:
+    BusError(const char* name, const std::string& message) : std::runtime_error(message), name_(name) {}
+    const char* name() const { return name_; }
+
+private:
+    const char* name_;
+};
+
+// everytouchd: the frame loop, the calibration, the configuration and the D-Bus interface around them, driven
+// by one sd-event loop on the main thread. Start-up is a straight chain of steps in run().
+class Daemon {
+public:
+    explicit Daemon(DaemonOptions options);
+    ~Daemon();
+    Daemon(const Daemon&) = delete;
+    Daemon& operator=(const Daemon&) = delete;
+
+    // Blocks SIGTERM, SIGINT and SIGHUP for this thread and every thread started after it, so that sd-event
+    // receives them, and ignores SIGPIPE: a client that closes its end of a Snapshot descriptor must not kill
+    // the daemon. Call first thing in main().
+    static void prepareSignals();
+
+    // Runs until SIGTERM or SIGINT, the end of the stream or a failure and returns the exit status. Throws
+    // io::InputError for bad options, configuration or rig (exit status kExitBadInput).
+    int run();
+
+    // What the bus shows. Main thread only, like everything below.
+    DaemonState state() const;
+    const std::string& rig() const { return rigName_; }
+    bool calibrated() const { return store_ && store_->active().has_value(); }
+    LoopStatistics statistics() const;
+    double touchHeightMm() const { return touchHeightMm_; }
+    const std::string& devicePath() const { return devicePath_; }
+
+    // What the bus offers; each throws BusError.
+    void setTouchHeightMm(double heightMm);
+    void calibrate(std::string_view request, const CalibrationOptions& options);
+    void saveCalibration();
+    void resetCalibration();
+    void reloadConfig();
+    // Replies to `call` once the next frame pair has been written to `fd` as a PNG.
+    void snapshot(sd_bus_message* call, std::string_view what, int fd);
+
+private:
+    struct PendingSnapshot {
+        Daemon* daemon = nullptr;
+        std::uint64_t id = 0;
+        io::BusMessage call;
+        io::UniqueFd fd;
+        SnapshotKind kind = SnapshotKind::Camera;
+        FrameTap::Ticket ticket = 0;
+        io::EventSource timeout;
+    };
+
+    struct CalibrationRun {
+        std::thread thread;
+        std::atomic<bool> cancelled{false};
+    };
+
+    void loadCalibration(const std::optional<io::RigDescription>& rig);
+    std::vector<io::TouchSink*> openOutputs();
+    int startEventLoop();
+    void startFrameLoop(std::vector<io::TouchSink*> sinks);
+    void connectBus();
+    void startWatchdog();
+    void onLoopNews();
+    void emitContacts();
+    void finishCalibration(const CalibrationOutcome& outcome);
+    void completeSnapshot(std::uint64_t id, const core::FramePair& pair);
+    void failSnapshot(std::uint64_t id, const char* errorName, const std::string& message);
+    void applySettings();
+    void refreshState();
+    void notifyStatus();
+    void shutDown();
+
+    static int onStopSignal(sd_event_source* source, const struct signalfd_siginfo* info,
+                            void* userdata) noexcept;
+    static int onReloadSignal(sd_event_source* source, const struct signalfd_siginfo* info,
+                              void* userdata) noexcept;
+    static int onWatchdog(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
+    static int onStatusTimer(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
+    static int onContactsTimer(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
+    static int onSnapshotTimeout(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
+
+    DaemonOptions options_;
+    DaemonConfig config_;
+    std::string rigName_;
+    bool cameraRig_ = false;
+    std::string devicePath_;  // the virtual touchscreen's event node; empty without one
+    double touchHeightMm_ = 0.0;
+
+    std::unique_ptr<io::FrameSource> source_;
+    std::unique_ptr<io::RecordingWriter> recorder_;
+    std::unique_ptr<io::ConsoleSink> console_;
+    std::unique_ptr<io::TouchLogWriter> touchLog_;
+    std::unique_ptr<TouchscreenOutput> touchscreen_;
+    std::optional<CalibrationStore> store_;
+
+    io::Event event_;
+    MainLoopInbox inbox_;
+    std::vector<io::EventSource> eventSources_;
+    io::EventSource contactsTimer_;
+    std::unique_ptr<BusService> bus_;
+    std::unique_ptr<FrameLoop> loop_;
+    std::unique_ptr<CalibrationRun> calibration_;
+    std::map<std::uint64_t, PendingSnapshot> snapshots_;
+    std::uint64_t nextSnapshotId_ = 1;
+
+    bool ready_ = false;
+    DaemonState reportedState_ = DaemonState::Starting;
+    bool reportedCalibrated_ = false;
+    std::uint64_t contactsVersion_ = 0;
+    std::chrono::steady_clock::time_point lastContactsSignal_;
+    std::uint64_t watchdogUsec_ = 0;
+    bool watchdogWarned_ = false;
+    int exitStatus_ = kExitSuccess;
+};
+
+}  // namespace everytouch::service

@@ -1,0 +1,80 @@
+#include "service/snapshot.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <cerrno>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/code_image.h"
+
+namespace everytouch::service {
+
+std::optional<SnapshotKind> parseSnapshotKind(std::string_view name) {
+    if (name == "camera")
+        return SnapshotKind::Camera;
+    if (name == "texture")
+        return SnapshotKind::Texture;
+    if (name == "subtraction")
+        return SnapshotKind::Subtraction;
+    return std::nullopt;
+}
+
+bool snapshotNeedsDetection(std::string_view name) {
+    return name == "mask" || name == "overlay";
+}
+
+void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
+    if (kind == SnapshotKind::Camera) {
+        pair.latest().image.copyTo(image);
+        return;
+    }
+    cv::Mat subtraction, texture;
+    core::computeSubtractionAndTexture(pair, subtraction, texture);
+    if (kind == SnapshotKind::Texture)
+        image = texture;
+    else
+        subtraction.convertTo(image, CV_8U);  // saturates: negative differences become 0
+}
+
+std::vector<unsigned char> encodePng(const cv::Mat& image) {
+    std::vector<unsigned char> bytes;
+    cv::imencode(".png", image, bytes);
+    return bytes;
+}
+
+int writeAllWithin(int fd, const std::vector<unsigned char>& bytes, std::chrono::milliseconds timeout) {
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags < 0)
+        return -errno;
+    if ((flags & O_ACCMODE) == O_RDONLY)
+        return -EBADF;
+    if (!(flags & O_NONBLOCK) && ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0)
+        return -errno;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    size_t written = 0;
+    while (written < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+        if (n >= 0) {
+            written += static_cast<size_t>(n);
+            continue;
+        }
+        if (errno == EINTR)
+            continue;
+        if (errno != EAGAIN)
+            return -errno;
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
+        if (left.count() <= 0)
+            return -ETIMEDOUT;
+        pollfd waiting{fd, POLLOUT, 0};
+        if (::poll(&waiting, 1, static_cast<int>(left.count())) < 0 && errno != EINTR)
+            return -errno;
+    }
+    return 0;
+}
+
+}  // namespace everytouch::service

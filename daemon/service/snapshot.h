@@ -1,0 +1,39 @@
+#pragma once
+
+#include <chrono>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "core/frame.h"
+
+namespace everytouch::service {
+
+// What a snapshot shows (the Snapshot method's `what`).
+enum class SnapshotKind {
+    Camera,       // the newer camera frame of a pair, as the camera gives it
+    Texture,      // T = (C+ + C-) / 2: the scene without the code
+    Subtraction,  // S = max over channels of (C+ - C-), negative differences clipped to 0: the code
+};
+
+inline constexpr const char* kSnapshotKinds = "camera, texture, subtraction";
+// Kinds that need touch detection, which this build does not have yet.
+inline constexpr const char* kSnapshotKindsNeedingDetection = "mask, overlay";
+
+std::optional<SnapshotKind> parseSnapshotKind(std::string_view name);
+bool snapshotNeedsDetection(std::string_view name);
+
+// Renders `kind` of `pair` into `image` (8-bit, the camera's channels; one channel for Subtraction).
+void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image);
+
+// PNG bytes of an 8-bit image.
+std::vector<unsigned char> encodePng(const cv::Mat& image);
+
+// Writes all of `bytes` to `fd`, a descriptor someone else passed us: waits at most `timeout` for it to
+// accept them, so a reader that never reads cannot stall the caller. Returns 0 or a negative errno
+// (-EBADF when the descriptor is not open for writing, -ETIMEDOUT).
+int writeAllWithin(int fd, const std::vector<unsigned char>& bytes, std::chrono::milliseconds timeout);
+
+}  // namespace everytouch::service

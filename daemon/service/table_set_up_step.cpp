@@ -1,0 +1,93 @@
+#include "service/table_set_up_step.h"
+
+#include <cstdio>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/code_image.h"
+#include "core/keystone.h"
+#include "core/plane_view.h"
+#include "core/projector_camera_pair.h"
+#include "core/table_rectangle.h"
+#include "core/table_setup.h"
+
+namespace everytouch::service {
+
+namespace {
+
+// The scene without the code, averaged over the pairs: the noise of n pairs drops by sqrt(n).
+cv::Mat averageTexture(const std::vector<core::FramePair>& pairs) {
+    cv::Mat subtraction, texture, sum;
+    for (const core::FramePair& pair : pairs) {
+        core::computeSubtractionAndTexture(pair, subtraction, texture);
+        if (sum.empty())
+            sum = cv::Mat::zeros(texture.size(), CV_MAKETYPE(CV_32F, texture.channels()));
+        cv::accumulate(texture, sum);
+    }
+    cv::Mat average;
+    sum.convertTo(average, CV_8U, 1.0 / static_cast<double>(pairs.size()));
+    return average;
+}
+
+EstimateResult failure(const std::string& problem) {
+    EstimateResult result;
+    result.problem = problem;
+    return result;
+}
+
+}  // namespace
+
+core::ChessboardOptions tableSetUpChessboard() {
+    core::ChessboardOptions options;
+    options.squarePx = 40;
+    return options;
+}
+
+EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
+                                   const std::optional<core::Calibration>& current,
+                                   const CalibrationOptions& options) {
+    if (!current)
+        return failure(
+            "it needs the projector-camera pair's calibration (both lenses and their pose), and "
+            "there is none");
+    if (pairs.empty())
+        return failure("no frames");
+    const core::ProjectorCameraPair pair = core::pairOf(*current);
+    const cv::Mat texture = averageTexture(pairs);
+
+    const core::ChessboardDetection board =
+        core::detectProjectedChessboard(texture, tableSetUpChessboard(), current->projectorSize);
+    if (!board.success)
+        return failure("the projected chessboard: " + board.message);
+    core::TableRectangleOptions cardOptions;
+    cardOptions.sizeMm = {options.cardWidthMm, options.cardHeightMm};
+    const core::TableRectangleDetection card = core::findTableRectangle(texture, cardOptions, pair.camera);
+    if (!card.success)
+        return failure("the card: " + card.message);
+
+    core::PlaneView table;
+    table.cameraPoints = board.cameraCorners;
+    table.projectorPoints = board.projectorCorners;
+    std::array<Eigen::Vector2d, 4> rawCorners;
+    for (std::size_t corner = 0; corner < rawCorners.size(); ++corner)
+        rawCorners[corner] = pair.camera.distortPixel(card.corners[corner]);
+    table.rectangleCorners = rawCorners;
+    core::TableSetupOptions setUpOptions;
+    setUpOptions.rectangleSizeMm = cardOptions.sizeMm;
+    const core::TableSetup setUp = core::setUpTable(pair, table, setUpOptions);
+    if (!setUp.success)
+        return failure(setUp.message);
+
+    EstimateResult result;
+    result.calibration = setUp.calibration;
+    result.calibration->displaySize = current->displaySize;
+    const core::KeystoneFit keystone = core::fitDisplayToTable(*result.calibration, current->displaySize);
+    if (!keystone.success)
+        return failure("fitting the display into the lit area: " + keystone.message);
+    result.calibration->displayToProjector = keystone.displayToProjector;
+    result.rmsPx = setUp.rmsPx.all;
+    return result;
+}
+
+}  // namespace everytouch::service

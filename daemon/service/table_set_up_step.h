@@ -1,0 +1,27 @@
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "core/calibration.h"
+#include "core/frame.h"
+#include "core/projector_chessboard.h"
+#include "service/calibration_job.h"
+
+namespace everytouch::service {
+
+// The board the projector shows for the table set-up: smaller squares than the core's default, so that a
+// white border of a few centimetres stays around it on the table for the card (paper Section IV: one
+// projected chessboard and a card's stripe give the table).
+core::ChessboardOptions tableSetUpChessboard();
+
+// The "table" calibration step, the paper's quick set-up on top of the projector-camera pair known from
+// `current`: the texture of the captured pairs (averaged) shows the projected chessboard and the card's
+// stripe in the border; their corners give table_to_camera and table_to_projector (core::setUpTable), and the
+// display is fitted undistorted into the lit area (core::fitDisplayToTable). Fails, saying why, without a
+// current calibration, when the board or the card is not found, or when the result does not fit.
+EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
+                                   const std::optional<core::Calibration>& current,
+                                   const CalibrationOptions& options);
+
+}  // namespace everytouch::service

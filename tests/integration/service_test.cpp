@@ -1,0 +1,780 @@
+// The real everytouchd on a private system bus that loads our shipped D-Bus policy, driven by the real
+// everytouch-calib, by busctl and by a plain sd-bus client.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/geometry.h"
+#include "io/calibration_file.h"
+#include "io/handles.h"
+#include "io/recording.h"
+#include "service/bus_names.h"
+#include "service/table_set_up_step.h"
+#include "support/coded_recording.h"
+#include "support/notify_socket.h"
+#include "support/private_bus.h"
+#include "support/process.h"
+#include "support/surface_renderer.h"
+#include "support/temp_dir.h"
+#include "support/test_group.h"
+#include "support/test_rig.h"
+
+namespace everytouch {
+
+// The "everytouch" group for the tests of group members (see main()).
+std::optional<gid_t> privilegedGroup;
+std::string privilegedGroupProblem;
+
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+// Generous for two busy cores; every wait ends as soon as its condition holds.
+constexpr auto kStartTimeout = 60s;
+constexpr auto kExitTimeout = 30s;
+
+const std::vector<std::string> kNobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                          "--clear-groups"};
+
+std::vector<std::string> concat(std::vector<std::string> first, const std::vector<std::string>& second) {
+    first.insert(first.end(), second.begin(), second.end());
+    return first;
+}
+
+std::vector<std::string> busctl(const std::vector<std::string>& arguments) {
+    return concat({"/usr/bin/busctl", "--system", "--no-pager"}, arguments);
+}
+
+std::vector<std::string> property(const std::string& verb, const std::string& name) {
+    return busctl({verb, bus::kBusName, bus::kObjectPath, bus::kInterface, name});
+}
+
+std::vector<std::string> call(const std::string& method, const std::vector<std::string>& arguments = {}) {
+    return concat(busctl({"call", bus::kBusName, bus::kObjectPath, bus::kInterface, method}), arguments);
+}
+
+std::string fileContents(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+// A recording long enough for any test (a minute at 10 frames/s), shared by the tests of one process.
+class SharedRecording {
+public:
+    static const std::filesystem::path& path() {
+        static SharedRecording recording;
+        return recording.path_;
+    }
+
+private:
+    SharedRecording() : path_(directory_ / "recording") {
+        std::filesystem::permissions(directory_.path(), std::filesystem::perms(0755));
+        test::writeCodedRecording(path_, test::smallRig(), 600, 100'000);
+    }
+    test::TempDir directory_;
+    std::filesystem::path path_;
+};
+
+// The paper-like rig with a lens that bends lines by a few pixels: the truth a calibration must recover.
+core::Calibration trueRig() {
+    core::Calibration rig = test::paperLikeCalibration();
+    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
+    return rig;
+}
+
+// A recording of the table while the projector shows the set-up board and the card's stripe lies in the
+// white border below it: 400 frames at 20 frames/s, rendered with 2 DN of sensor noise.
+class CalibrationSceneRecording {
+public:
+    static const std::filesystem::path& path() {
+        static CalibrationSceneRecording recording;
+        return recording.path_;
+    }
+
+private:
+    CalibrationSceneRecording() : path_(directory_ / "scene") {
+        std::filesystem::permissions(directory_.path(), std::filesystem::perms(0755));
+        io::RigDescription rig = test::paperLikeRig();
+        rig.calibration = trueRig();
+        test::SurfaceScene scene;
+        scene.rig = rig.calibration;
+        test::DarkRectangle stripe;
+        stripe.originMm = core::applyHomography(rig.calibration.tableToProjectorHomography().inverse(),
+                                                Eigen::Vector2d(320, 420)) -
+                          Eigen::Vector2d(85.5 / 2, 12.5 / 2);
+        scene.rectangles.push_back(stripe);
+        cv::Mat board;
+        core::renderProjectorChessboard(service::tableSetUpChessboard(), rig.calibration.projectorSize,
+                                        board);
+        const cv::Mat images[2] = {test::renderSurface(scene, board, 2.0, 1),
+                                   test::renderSurface(scene, board, 2.0, 2)};
+        io::RecordingWriter writer(path_, rig, false);
+        for (std::uint64_t i = 0; i < 400; ++i) {
+            core::Frame frame;
+            frame.index = i;
+            frame.timestampUs = static_cast<std::int64_t>(i) * 50'000;
+            frame.polarity = i % 2 ? core::Polarity::Negative : core::Polarity::Positive;
+            frame.image = images[i % 2];
+            writer.addFrame(frame);
+        }
+        writer.flush();
+    }
+    test::TempDir directory_;
+    std::filesystem::path path_;
+};
+
+// Starts everytouchd per test on a private bus; prints its log when the test fails.
+class ServiceTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() { bus_ = new test::PrivateBus(POLICY_FILE, permissiveBus_); }
+    static void TearDownTestSuite() {
+        delete bus_;
+        bus_ = nullptr;
+    }
+
+    void SetUp() override {
+        std::filesystem::permissions(dir_.path(), std::filesystem::perms(0755));
+        writeConfig("");
+    }
+
+    void TearDown() override {
+        if (daemon_ && daemon_->running()) {
+            daemon_->signal(SIGTERM);
+            const std::optional<int> status = daemon_->wait(kExitTimeout);
+            EXPECT_EQ(status, 0) << "everytouchd did not stop cleanly on SIGTERM";
+        }
+        if (HasFailure() && daemon_)
+            std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
+    }
+
+    std::filesystem::path configPath() const { return dir_ / "everytouchd.conf"; }
+    // Replaces the configuration at once, as a careful editor does: a reload never sees half a file.
+    void writeConfig(const std::string& text) {
+        std::ofstream(dir_ / "next.conf") << text;
+        std::filesystem::rename(dir_ / "next.conf", configPath());
+    }
+
+    void startDaemon(const std::vector<std::string>& extra = {},
+                     const std::vector<std::pair<std::string, std::string>>& environment = {},
+                     const std::filesystem::path& recording = SharedRecording::path()) {
+        notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
+        std::vector<std::pair<std::string, std::string>> variables = {
+            {"NOTIFY_SOCKET", notify_->path().string()}};
+        variables.insert(variables.end(), environment.begin(), environment.end());
+        daemon_ = std::make_unique<test::BackgroundProcess>(
+            concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig",
+                    "replay:" + recording.string()},
+                   extra),
+            dir_ / "everytouchd.log", variables);
+        ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    }
+
+    // Polls busctl until the property reads `expected`.
+    bool waitForProperty(const std::string& name, const std::string& expected) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (test::runProcess(property("get-property", name)).out == expected + "\n")
+                return true;
+            std::this_thread::sleep_for(20ms);
+        }
+        return false;
+    }
+
+    bool waitForLog(const std::string& text) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (daemon_->output().find(text) != std::string::npos)
+                return true;
+            std::this_thread::sleep_for(20ms);
+        }
+        return false;
+    }
+
+    std::string get(const std::string& name) {
+        const test::ProcessResult result = test::runProcess(property("get-property", name));
+        EXPECT_EQ(result.exitCode, 0) << result.err;
+        return result.out;
+    }
+
+    static inline test::PrivateBus* bus_ = nullptr;
+    static inline bool permissiveBus_ = false;
+    test::TempDir dir_;
+    std::unique_ptr<test::NotifySocket> notify_;
+    std::unique_ptr<test::BackgroundProcess> daemon_;
+};
+
+TEST_F(ServiceTest, PropertiesAreReadableByEveryone) {
+    startDaemon();
+    for (const std::vector<std::string>& prefix : {std::vector<std::string>{}, kNobody}) {
+        const test::ProcessResult result = test::runProcess(concat(
+            prefix, busctl({"get-property", bus::kBusName, bus::kObjectPath, bus::kInterface, "APIVersion",
+                            "State", "Rig", "Calibrated", "TouchHeightMm", "DevicePath"})));
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        EXPECT_EQ(result.out, "u 1\ns \"running\"\ns \"replay:" + SharedRecording::path().string() +
+                                  "\"\nb true\nd 3\ns \"\"\n");
+    }
+    const test::ProcessResult status = test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "status"}));
+    EXPECT_EQ(status.exitCode, 0) << status.err;
+    EXPECT_THAT(status.out, HasSubstr("State:         running"));
+    EXPECT_THAT(status.out, HasSubstr("Calibrated:    yes"));
+    EXPECT_THAT(status.out, HasSubstr("Touch height:  3.0 mm"));
+}
+
+TEST_F(ServiceTest, StatisticsFollowTheCamera) {
+    startDaemon();
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    double frameRate = 0.0;
+    while (std::chrono::steady_clock::now() < deadline && !(frameRate > 8.0 && frameRate < 12.0)) {
+        std::this_thread::sleep_for(100ms);
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &frameRate);
+    }
+    EXPECT_GT(frameRate, 8.0);  // the recording runs at 10 frames/s
+    EXPECT_LT(frameRate, 12.0);
+    EXPECT_THAT(get("LatencyMs"), HasSubstr("d "));
+    EXPECT_THAT(get("DroppedFrames"), HasSubstr("t "));
+}
+
+TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
+    startDaemon();
+    const test::ProcessResult result = test::runProcess(busctl(
+        {"call", bus::kBusName, bus::kObjectPath, "org.freedesktop.DBus.Introspectable", "Introspect"}));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    for (
+        const char* expected :
+        {R"(<method name=\"Calibrate\">\n   <arg type=\"s\" name=\"step\" direction=\"in\"/>\n   <arg type=\"a{sv}\" name=\"options\" direction=\"in\"/>)",
+         R"(<arg type=\"h\" name=\"fd\" direction=\"in\"/>)", R"(<arg type=\"a(uddbd)\" name=\"contacts\"/>)",
+         R"(<arg type=\"d\" name=\"rms_px\"/>)",
+         R"(<property name=\"FrameRate\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
+         R"(<property name=\"TouchHeightMm\" type=\"d\" access=\"readwrite\">)"})
+        EXPECT_THAT(result.out, HasSubstr(expected));
+}
+
+TEST_F(ServiceTest, TouchHeightIsSetAndRangeChecked) {
+    startDaemon();
+    // A plain sd-bus client listens for PropertiesChanged meanwhile.
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus listener(raw);
+    int changes = 0;
+    sd_bus_slot* slot = nullptr;
+    ASSERT_GE(sd_bus_match_signal(
+                  listener.get(), &slot, bus::kBusName, bus::kObjectPath, "org.freedesktop.DBus.Properties",
+                  "PropertiesChanged",
+                  [](sd_bus_message* message, void* userdata, sd_bus_error*) {
+                      const char* interface = nullptr;
+                      if (sd_bus_message_read(message, "s", &interface) >= 0 &&
+                          std::string(interface) == bus::kInterface)
+                          ++*static_cast<int*>(userdata);
+                      return 0;
+                  },
+                  &changes),
+              0);
+    const io::BusSlot match(slot);
+
+    test::ProcessResult result =
+        test::runProcess(concat(property("set-property", "TouchHeightMm"), {"d", "7.5"}));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 7.5\n");
+    const auto deadline = std::chrono::steady_clock::now() + 10s;
+    while (changes == 0 && std::chrono::steady_clock::now() < deadline) {
+        if (sd_bus_process(listener.get(), nullptr) == 0)
+            sd_bus_wait(listener.get(), 100'000);
+    }
+    EXPECT_GE(changes, 1) << "no PropertiesChanged for TouchHeightMm";
+
+    for (const double bad : {-1.0, 30.5, std::numeric_limits<double>::quiet_NaN()}) {
+        io::UniqueBusError error;
+        EXPECT_LT(sd_bus_set_property(listener.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                      "TouchHeightMm", error.get(), "d", bad),
+                  0);
+        EXPECT_TRUE(error.has(SD_BUS_ERROR_INVALID_ARGS)) << bad << ": " << error.name();
+        EXPECT_THAT(error.message(), HasSubstr("TouchHeightMm must be from 0 to 30 mm, not ")) << bad;
+    }
+    for (const std::vector<std::string>& wrongType : {std::vector<std::string>{"s", "deep"}, {"u", "4"}}) {
+        result = test::runProcess(concat(property("set-property", "TouchHeightMm"), wrongType));
+        EXPECT_NE(result.exitCode, 0) << wrongType[0];
+        EXPECT_THAT(result.err, HasSubstr("Incorrect parameters for property 'TouchHeightMm', expected 'd'"));
+    }
+    EXPECT_EQ(get("TouchHeightMm"), "d 7.5\n");
+}
+
+TEST_F(ServiceTest, SensitivityCommandSetsAndShowsTheTouchHeight) {
+    startDaemon();
+    test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "sensitivity", "12"});
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 12\n");
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "sensitivity"});
+    EXPECT_EQ(result.out, "12\n");
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "sensitivity", "99"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("TouchHeightMm must be from 0 to 30 mm, not 99"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "sensitivity", "deep"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_EQ(get("TouchHeightMm"), "d 12\n");
+}
+
+TEST_F(ServiceTest, CalibrateRejectsBadArgumentsWithoutChangingState) {
+    startDaemon();
+    const std::pair<std::vector<std::string>, const char*> cases[] = {
+        {{"sa{sv}", "everything", "0"},
+         "Unknown calibration step \"everything\"; expected projector, table or full"},
+        {{"sa{sv}", "full", "1", "frames", "s", "many"},
+         "Calibrate option \"frames\" must be of type u, not s"},
+        {{"sa{sv}", "full", "1", "frames", "u", "0"}, "Calibrate option frames: must be from 1 to 120"},
+        {{"sa{sv}", "full", "1", "colour", "u", "1"}, "Unknown Calibrate option \"colour\""},
+        {{"s", "full"},
+         "Invalid arguments 's' to call org.everytouch.Daemon1.Calibrate(), expecting 'sa{sv}'"},
+        {{"su", "full", "3"}, "Invalid arguments 'su' to call"},
+    };
+    for (const auto& [arguments, expected] : cases) {
+        const test::ProcessResult result = test::runProcess(concat(call("Calibrate"), arguments));
+        EXPECT_NE(result.exitCode, 0) << arguments[1];
+        EXPECT_THAT(result.err, HasSubstr(expected)) << arguments[1];
+    }
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    EXPECT_TRUE(daemon_->running());
+}
+
+TEST_F(ServiceTest, CalibrateSaysWhichStepsThisBuildCannotRun) {
+    startDaemon();
+    const test::ProcessResult direct = test::runProcess(concat(call("Calibrate"), {"sa{sv}", "full", "0"}));
+    EXPECT_NE(direct.exitCode, 0);
+    EXPECT_THAT(direct.err,
+                HasSubstr("The projector step (the one-time calibration of the projector-camera pair "
+                          "from several poses of a board) is not part of this build yet; the current "
+                          "calibration stays active"));
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "projector"});
+    EXPECT_EQ(tool.exitCode, 1);
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: The projector step"));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+}
+
+TEST_F(ServiceTest, AFailedCalibrationKeepsThePreviousOne) {
+    startDaemon();
+    const test::ProcessResult tool =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "2", "--no-save"});
+    EXPECT_EQ(tool.exitCode, 1);
+    EXPECT_THAT(tool.err, HasSubstr("table: The projector shows a chessboard"));
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: the table step failed: the projected chessboard: "));
+    EXPECT_THAT(tool.err, HasSubstr("The previous calibration stays active."));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+}
+
+TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
+    // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
+    // degrees under the unchanged projector-camera pair.
+    const core::Calibration truth = trueRig();
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemon({}, {}, CalibrationSceneRecording::path());
+
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    EXPECT_THAT(tool.err, HasSubstr("100% table: Done with the table set-up"));
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    EXPECT_THAT(tool.out, HasSubstr("Saved"));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+
+    // The saved calibration maps the projector onto the camera through the table as the truth does, wherever
+    // the projector lights it (the table frame itself is now the card's).
+    const core::Calibration saved = io::readCalibrationFile(dir_ / "calibration.yml");
+    double worstPx = 0;
+    for (double x = 40; x <= 600; x += 80)
+        for (double y = 40; y <= 440; y += 80) {
+            const Eigen::Vector2d projector(x, y);
+            worstPx =
+                std::max(worstPx, (core::applyHomography(saved.projectorToCameraHomography(), projector) -
+                                   core::applyHomography(truth.projectorToCameraHomography(), projector))
+                                      .norm());
+        }
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_projector_to_camera_px", std::to_string(worstPx));
+    EXPECT_LT(worstPx, 0.5);
+    double movedWorstPx = 0;
+    for (const Eigen::Vector2d& projector : {Eigen::Vector2d(40, 40), Eigen::Vector2d(600, 440)})
+        movedWorstPx =
+            std::max(movedWorstPx, (core::applyHomography(moved.projectorToCameraHomography(), projector) -
+                                    core::applyHomography(truth.projectorToCameraHomography(), projector))
+                                       .norm());
+    RecordProperty("stored_worst_projector_to_camera_px", std::to_string(movedWorstPx));
+    EXPECT_GT(movedWorstPx, 2.0) << "the stored calibration should have been off before";
+    EXPECT_FALSE(saved.validate());
+}
+
+TEST_F(ServiceTest, ASecondCalibrationWhileOneRunsIsBusy) {
+    startDaemon({}, {}, CalibrationSceneRecording::path());
+    test::BackgroundProcess tool(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "100", "--no-save"},
+        dir_ / "calibrate.log");
+    EXPECT_TRUE(waitForProperty("State", "s \"calibrating\""));
+    test::ProcessResult result = test::runProcess(call("Calibrate", {"sa{sv}", "table", "0"}));
+    EXPECT_THAT(result.err, HasSubstr("A calibration is already running"));
+    result = test::runProcess(call("ResetCalibration"));
+    EXPECT_THAT(result.err, HasSubstr("A calibration is running"));
+    EXPECT_EQ(tool.wait(kExitTimeout), 0) << tool.output();
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+}
+
+TEST_F(ServiceTest, AnUnprivilegedCallerCanReadButNotChangeAnything) {
+    startDaemon();
+    const std::vector<std::vector<std::string>> changes = {
+        concat(property("set-property", "TouchHeightMm"), {"d", "5"}),
+        call("Calibrate", {"sa{sv}", "full", "0"}),
+        call("SaveCalibration"),
+        call("ResetCalibration"),
+        call("ReloadConfig"),
+    };
+    for (const std::vector<std::string>& change : changes) {
+        const test::ProcessResult result = test::runProcess(concat(kNobody, change));
+        EXPECT_NE(result.exitCode, 0) << change[5];
+        EXPECT_THAT(result.err, HasSubstr("Access denied")) << change[5];
+    }
+    const test::ProcessResult tool =
+        test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "sensitivity", "5"}));
+    EXPECT_EQ(tool.exitCode, 4);
+    EXPECT_THAT(tool.err,
+                HasSubstr("Setting the touch height needs root or membership in the \"everytouch\" group"));
+    EXPECT_EQ(get("TouchHeightMm"), "d 3\n");
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    const test::ProcessResult snapshot =
+        test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "snapshot", "camera", "/tmp/unused.png"}));
+    EXPECT_EQ(snapshot.exitCode, 4) << snapshot.err;
+}
+
+TEST_F(ServiceTest, SnapshotsArePngsOfWhatTheCameraSees) {
+    startDaemon();
+    const test::CodedImages images = test::codedImages(test::smallRig().calibration.cameraSize, 10);
+    for (const char* what : {"camera", "texture", "subtraction"}) {
+        const std::filesystem::path file = dir_ / (std::string(what) + ".png");
+        const test::ProcessResult result =
+            test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", what, file.string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+        const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+        ASSERT_EQ(image.size(), test::smallRig().calibration.cameraSize) << what;
+        ASSERT_EQ(image.type(), CV_8UC1) << what;
+        if (std::string(what) == "camera") {
+            EXPECT_TRUE(cv::norm(image, images.positive, cv::NORM_INF) == 0.0 ||
+                        cv::norm(image, images.negative, cv::NORM_INF) == 0.0);
+        } else if (std::string(what) == "texture") {
+            EXPECT_LE(cv::norm(image, (images.positive + images.negative) / 2, cv::NORM_INF), 1.0);
+        } else {
+            EXPECT_EQ(cv::norm(image, images.positive - images.negative, cv::NORM_INF), 0.0);
+        }
+    }
+    test::ProcessResult result =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "mask", (dir_ / "mask.png").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Snapshot \"mask\" is not available yet"));
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "mask.png"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "photo", (dir_ / "photo.png").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Unknown snapshot \"photo\""));
+
+    // A descriptor opened for reading is refused.
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus client(raw);
+    const io::UniqueFd readOnly(::open(POLICY_FILE, O_RDONLY | O_CLOEXEC));
+    io::UniqueBusError error;
+    EXPECT_LT(sd_bus_call_method(client.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "Snapshot",
+                                 error.get(), nullptr, "sh", "camera", readOnly.get()),
+              0);
+    EXPECT_TRUE(error.has(SD_BUS_ERROR_INVALID_ARGS));
+    EXPECT_THAT(error.message(), HasSubstr("not open for writing"));
+}
+
+TEST_F(ServiceTest, SurvivesClientsThatDisconnectMidCall) {
+    startDaemon();
+    for (int i = 0; i < 5; ++i) {
+        sd_bus* raw = nullptr;
+        ASSERT_GE(sd_bus_open_system(&raw), 0);
+        io::Bus client(raw);
+        int ends[2];
+        ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
+        const io::UniqueFd readEnd(ends[0]), writeEnd(ends[1]);
+        sd_bus_message* message = nullptr;
+        ASSERT_GE(sd_bus_message_new_method_call(client.get(), &message, bus::kBusName, bus::kObjectPath,
+                                                 bus::kInterface, "Snapshot"),
+                  0);
+        const io::BusMessage call(message);
+        ASSERT_GE(sd_bus_message_append(call.get(), "sh", "camera", writeEnd.get()), 0);
+        ASSERT_GE(sd_bus_send(client.get(), call.get(), nullptr), 0);
+        client.reset();  // flushes the call, then hangs up before the reply
+    }
+    const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
+    EXPECT_EQ(status.exitCode, 0) << status.err;
+    const test::ProcessResult snapshot =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "after.png").string()});
+    EXPECT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    EXPECT_TRUE(daemon_->running());
+}
+
+TEST_F(ServiceTest, SigtermStopsCleanlyAndReleasesContacts) {
+    startDaemon({"--log", (dir_ / "touches.jsonl").string()});
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_THAT(daemon_->output(), HasSubstr("stopping on TERM"));
+    EXPECT_THAT(daemon_->output(), HasSubstr("all contacts released"));
+    EXPECT_TRUE(notify_->waitFor("STOPPING=1", 0ms));
+}
+
+TEST_F(ServiceTest, TheEndOfTheStreamEndsTheDaemon) {
+    startDaemon({"--frames", "30", "--fast"});
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_THAT(daemon_->output(), HasSubstr("processed 30 frames (29 pairs)"));
+}
+
+TEST_F(ServiceTest, WatchdogIsPingedWhenSystemdAsks) {
+    startDaemon({}, {{"WATCHDOG_USEC", "400000"}});
+    EXPECT_TRUE(notify_->waitFor("WATCHDOG=1", kStartTimeout));
+    EXPECT_TRUE(notify_->waitFor("STATUS=", 0ms));
+}
+
+TEST_F(ServiceTest, ReloadRejectsABadConfigurationAndAppliesAGoodOne) {
+    writeConfig("[Touch]\nHeightMm=4\n");
+    startDaemon();
+    const pid_t pid = daemon_->pid();
+    EXPECT_EQ(get("TouchHeightMm"), "d 4\n");
+
+    writeConfig("[Touch]\nHeightMm=4\nSensitivity=9\n");
+    test::ProcessResult result = test::runProcess(call("ReloadConfig"));
+    EXPECT_NE(result.exitCode, 0);
+    EXPECT_THAT(result.err, HasSubstr("everytouchd.conf:3: [Touch] Sensitivity: unknown key"));
+    writeConfig("[Touch]\nHeightMm=4\n\n[Output]\nUinput=perhaps\n");
+    daemon_->signal(SIGHUP);
+    EXPECT_TRUE(waitForLog("everytouchd.conf:5: [Output] Uinput: expected yes or no"));
+    EXPECT_EQ(get("TouchHeightMm"), "d 4\n");
+
+    // Applied without a restart; a height set over the bus stays unless the files change it.
+    writeConfig("[Touch]\nHeightMm=9\n");
+    daemon_->signal(SIGHUP);
+    EXPECT_TRUE(waitForProperty("TouchHeightMm", "d 9"));
+    ASSERT_EQ(test::runProcess(concat(property("set-property", "TouchHeightMm"), {"d", "2"})).exitCode, 0);
+    result = test::runProcess(call("ReloadConfig"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 2\n");
+    writeConfig("[Touch]\nHeightMm=11\n");
+    result = test::runProcess(call("ReloadConfig"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 11\n");
+    EXPECT_EQ(daemon_->pid(), pid);
+    EXPECT_TRUE(daemon_->running());
+}
+
+TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
+    std::ofstream(dir_ / "calibration.yml") << "%YAML:1.0\n---\nformat: everytouch-calibration\nversion: 7\n";
+    const std::string before = fileContents(dir_ / "calibration.yml");
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemon();
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    EXPECT_EQ(get("Calibrated"), "b false\n");
+    EXPECT_THAT(daemon_->output(), HasSubstr("calibration.yml: version: unsupported version"));
+    const test::ProcessResult save = test::runProcess(call("SaveCalibration"));
+    EXPECT_THAT(save.err, HasSubstr("There is no calibration to save"));
+    EXPECT_EQ(fileContents(dir_ / "calibration.yml"), before);
+}
+
+TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveOne) {
+    core::Calibration stored = test::smallRig().calibration;
+    stored.displayToProjector(0, 2) = 3.25;
+    io::writeCalibrationFile(dir_ / "calibration.yml", stored);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemon();
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    struct stat before {};
+    ASSERT_EQ(::stat((dir_ / "calibration.yml").c_str(), &before), 0);
+    test::ProcessResult result = test::runProcess(call("SaveCalibration"));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    struct stat after {};
+    ASSERT_EQ(::stat((dir_ / "calibration.yml").c_str(), &after), 0);
+    EXPECT_NE(before.st_ino, after.st_ino) << "not replaced by rename";
+    EXPECT_DOUBLE_EQ(io::readCalibrationFile(dir_ / "calibration.yml").displayToProjector(0, 2), 3.25);
+
+    result = test::runProcess(call("ResetCalibration"));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("Calibrated"), "b false\n");
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    result = test::runProcess(call("SaveCalibration"));
+    EXPECT_THAT(result.err, HasSubstr("There is no calibration to save"));
+    EXPECT_TRUE(std::filesystem::exists(dir_ / "calibration.yml"));
+}
+
+TEST_F(ServiceTest, ARigWithoutACalibrationFileCannotSave) {
+    startDaemon();
+    const test::ProcessResult result = test::runProcess(call("SaveCalibration"));
+    EXPECT_NE(result.exitCode, 0);
+    EXPECT_THAT(result.err, HasSubstr("no calibration file is configured; set [Calibration] Path="));
+}
+
+TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
+    if (!privilegedGroup)
+        GTEST_SKIP() << "cannot provide the \"everytouch\" group: " << privilegedGroupProblem;
+    startDaemon();
+    const std::vector<std::string> member = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                             "--groups=" + std::to_string(*privilegedGroup)};
+    test::ProcessResult result =
+        test::runProcess(concat(member, {EVERYTOUCH_CALIB_PATH, "sensitivity", "6"}));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 6\n");
+    result = test::runProcess(concat(member, call("Calibrate", {"sa{sv}", "full", "0"})));
+    EXPECT_THAT(result.err, HasSubstr("is not part of this build yet"));
+}
+
+TEST_F(ServiceTest, TheToolSaysWhenTheDaemonIsNotRunning) {
+    for (const std::vector<std::string>& command : {std::vector<std::string>{EVERYTOUCH_CALIB_PATH, "status"},
+                                                    {EVERYTOUCH_CALIB_PATH, "sensitivity", "4"}}) {
+        const test::ProcessResult result = test::runProcess(command);
+        EXPECT_EQ(result.exitCode, 3);
+        EXPECT_THAT(result.err, HasSubstr("everytouchd is not running"));
+    }
+}
+
+TEST_F(ServiceTest, TheToolPassesCalibrationOptionsOn) {
+    startDaemon();
+    test::ProcessResult result =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--card-width-mm", "-3"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Calibrate option card_width_mm: must be more than 0"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table", "--frames", "500"});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("Calibrate option frames: must be from 1 to 120"));
+    result = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "sideways"});
+    EXPECT_EQ(result.exitCode, 2);
+}
+
+// The same daemon behind a bus that lets anyone call anything: its own credential checks must hold.
+class DaemonOwnChecksTest : public ServiceTest {
+protected:
+    static void SetUpTestSuite() {
+        permissiveBus_ = true;
+        ServiceTest::SetUpTestSuite();
+    }
+    static void TearDownTestSuite() {
+        ServiceTest::TearDownTestSuite();
+        permissiveBus_ = false;
+    }
+};
+
+TEST_F(DaemonOwnChecksTest, CallersNeitherRootNorInTheGroupAreRefused) {
+    startDaemon();
+    // dbus-send prints the daemon's own error message (busctl shortens every AccessDenied to "Access
+    // denied").
+    const auto dbusSend = [](const std::string& member, const std::vector<std::string>& arguments) {
+        return concat(concat(kNobody, {"/usr/bin/dbus-send", "--system", "--print-reply",
+                                       std::string("--dest=") + bus::kBusName, bus::kObjectPath, member}),
+                      arguments);
+    };
+    const std::pair<std::vector<std::string>, const char*> changes[] = {
+        {dbusSend("org.freedesktop.DBus.Properties.Set",
+                  {std::string("string:") + bus::kInterface, "string:TouchHeightMm", "variant:double:5"}),
+         "Setting TouchHeightMm"},
+        {dbusSend(std::string(bus::kInterface) + ".SaveCalibration", {}), "Saving the calibration"},
+        {dbusSend(std::string(bus::kInterface) + ".ResetCalibration", {}), "Resetting the calibration"},
+        {dbusSend(std::string(bus::kInterface) + ".ReloadConfig", {}), "Reloading the configuration"},
+    };
+    for (const auto& [change, action] : changes) {
+        const test::ProcessResult result = test::runProcess(change);
+        EXPECT_NE(result.exitCode, 0) << action;
+        EXPECT_THAT(result.err, HasSubstr(std::string("org.freedesktop.DBus.Error.AccessDenied: ") + action +
+                                          " needs root or membership in the \"everytouch\" group"));
+    }
+    const test::ProcessResult calibrate =
+        test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "calibrate", "projector"}));
+    EXPECT_EQ(calibrate.exitCode, 4) << calibrate.err;
+    std::filesystem::create_directory(dir_ / "public");
+    std::filesystem::permissions(dir_ / "public", std::filesystem::perms::all);
+    const test::ProcessResult snapshot = test::runProcess(concat(
+        kNobody, {EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "public" / "camera.png").string()}));
+    EXPECT_EQ(snapshot.exitCode, 4) << snapshot.err;
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "public" / "camera.png"));
+    EXPECT_EQ(get("TouchHeightMm"), "d 3\n");
+    EXPECT_EQ(test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "status"})).exitCode, 0);
+}
+
+TEST_F(DaemonOwnChecksTest, GroupMembersAreLetIn) {
+    if (!privilegedGroup)
+        GTEST_SKIP() << "cannot provide the \"everytouch\" group: " << privilegedGroupProblem;
+    startDaemon();
+    const test::ProcessResult result =
+        test::runProcess(concat({"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                 "--groups=" + std::to_string(*privilegedGroup)},
+                                concat(property("set-property", "TouchHeightMm"), {"d", "8"})));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("TouchHeightMm"), "d 8\n");
+}
+
+// Processes without the bus.
+
+TEST(EverytouchdConfig, ErrorsAtStartNameFileLineAndKey) {
+    test::TempDir dir;
+    std::ofstream(dir / "everytouchd.conf") << "[Camera]\nRig=sim\n\n[Touch]\nHeightMm=40\n";
+    test::ProcessResult result =
+        test::runProcess({EVERYTOUCHD_PATH, "--config", (dir / "everytouchd.conf").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err,
+                HasSubstr("everytouchd.conf:5: [Touch] HeightMm: must be from 0 to 30 mm, found 40"));
+
+    std::ofstream(dir / "everytouchd.conf") << "[Touch]\nHeightMm=4\n";
+    std::filesystem::create_directory(dir / "everytouchd.conf.d");
+    std::ofstream(dir / "everytouchd.conf.d" / "local.conf") << "[Camera]\nCamera=aravis\n";
+    result = test::runProcess({EVERYTOUCHD_PATH, "--config", (dir / "everytouchd.conf").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("local.conf:2: [Camera] Camera: unknown key"));
+
+    result = test::runProcess({EVERYTOUCHD_PATH, "--config", (dir / "absent.conf").string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("absent.conf: no such file"));
+}
+
+TEST(EverytouchdService, WithoutACameraSaysSoAndExits) {
+    test::TempDir dir;
+    std::ofstream(dir / "everytouchd.conf") << "[Touch]\nHeightMm=4\n";
+    test::NotifySocket notify(dir / "notify.socket");
+    test::BackgroundProcess daemon(
+        {EVERYTOUCHD_PATH, "--service", "--config", (dir / "everytouchd.conf").string()}, dir / "log",
+        {{"NOTIFY_SOCKET", notify.path().string()}});
+    EXPECT_EQ(daemon.wait(kExitTimeout), 6);
+    EXPECT_TRUE(notify.waitFor("STATUS=No camera configured: set [Camera] Rig= in " +
+                                   (dir / "everytouchd.conf").string() + " (see everytouchd(8))",
+                               kExitTimeout))
+        << daemon.output();
+    EXPECT_THAT(daemon.output(), HasSubstr("No camera configured"));
+    EXPECT_FALSE(notify.waitFor("READY=1", 0ms));
+}
+
+}  // namespace
+}  // namespace everytouch
+
+int main(int argc, char** argv) {
+    using namespace everytouch;
+    // First, while this process has a single thread (see provideGroup).
+    privilegedGroup = test::provideGroup(bus::kPrivilegedGroup, privilegedGroupProblem);
+    ::testing::InitGoogleTest(&argc, argv);
+    return RUN_ALL_TESTS();
+}

@@ -1,0 +1,74 @@
+// The files that install everytouchd as a service: the unit, the example configuration, the manual page.
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "service/config.h"
+#include "support/process.h"
+#include "support/temp_dir.h"
+
+namespace everytouch {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string contents(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+TEST(SystemFiles, TheUnitVerifies) {
+    // systemd-analyze exits 0 even on typos; it prints nothing only when everything is understood.
+    const test::ProcessResult result =
+        test::runProcess({"/usr/bin/systemd-analyze", "verify", "--man=no", BUILD_UNIT_FILE});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_EQ(result.out + result.err, "");
+}
+
+TEST(SystemFiles, TheUnitStaysHardened) {
+    const test::ProcessResult result = test::runProcess(
+        {"/usr/bin/systemd-analyze", "security", "--offline=true", "--threshold=30", BUILD_UNIT_FILE});
+    EXPECT_EQ(result.exitCode, 0) << "exposure above 3.0:\n" << result.out;
+    EXPECT_THAT(contents(BUILD_UNIT_FILE), HasSubstr("Type=notify"));
+    EXPECT_THAT(contents(BUILD_UNIT_FILE), HasSubstr("ExecStart=" EVERYTOUCHD_PATH " --service"));
+}
+
+// The keys the example shows commented out, as "[Section] Key".
+std::set<std::string> commentedKeys(const std::string& example) {
+    std::set<std::string> keys;
+    std::istringstream lines(example);
+    std::string section;
+    std::smatch match;
+    for (std::string line; std::getline(lines, line);) {
+        if (std::regex_match(line, match, std::regex("\\[(\\w+)\\]")))
+            section = match[1];
+        else if (std::regex_match(line, match, std::regex("#(\\w+)=.*")))
+            keys.insert("[" + section + "] " + std::string(match[1]));
+    }
+    return keys;
+}
+
+TEST(SystemFiles, TheExampleConfigurationAndTheManualDocumentEveryKey) {
+    const std::string example = contents(EXAMPLE_CONFIG);
+    const std::string manual = contents(DAEMON_MANUAL);
+    std::set<std::string> known;
+    for (const auto& [section, key] : service::configKeys()) {
+        known.insert("[" + section + "] " + key);
+        EXPECT_THAT(manual, HasSubstr("*[" + section + "] " + key + "=*"));
+    }
+    EXPECT_EQ(commentedKeys(example), known);
+    // With every default uncommented it is still a valid configuration.
+    test::TempDir dir;
+    std::ofstream(dir / "everytouchd.conf") << std::regex_replace(example, std::regex("\\n#(\\w+=)"), "\n$1");
+    const service::DaemonConfig config = service::loadConfig(dir / "everytouchd.conf", true);
+    EXPECT_EQ(config, service::DaemonConfig());
+}
+
+}  // namespace
+}  // namespace everytouch

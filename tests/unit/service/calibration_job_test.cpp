@@ -1,0 +1,139 @@
+#include "service/calibration_job.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "support/test_rig.h"
+
+namespace everytouch::service {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct ProgressEvent {
+    std::string step;
+    double fraction;
+    std::string message;
+};
+
+std::vector<core::FramePair> pairsNumbered(std::size_t count, std::uint64_t first) {
+    std::vector<core::FramePair> pairs(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        pairs[i].positive.index = first + 2 * i;
+        pairs[i].negative.index = first + 2 * i + 1;
+    }
+    return pairs;
+}
+
+// Steps whose estimators shift the display by their step number, so the test can see which results were
+// chained through.
+CalibrationStep shiftingStep(const std::string& name, double shift, double rmsPx,
+                             std::vector<std::size_t>& pairsSeen) {
+    return {name, name + " description", name + " prompt",
+            [shift, rmsPx, &pairsSeen](const std::vector<core::FramePair>& pairs,
+                                       const std::optional<core::Calibration>& current,
+                                       const CalibrationOptions&) {
+                pairsSeen.push_back(pairs.size());
+                EstimateResult result;
+                result.calibration = current.value_or(test::paperLikeCalibration());
+                result.calibration->displayToProjector(0, 2) += shift;
+                result.rmsPx = rmsPx;
+                return result;
+            }};
+}
+
+TEST(CalibrationJob, KnowsItsSteps) {
+    ASSERT_TRUE(calibrationSteps("full"));
+    EXPECT_EQ(calibrationSteps("full")->size(), 2u);
+    EXPECT_EQ(calibrationSteps("full")->front().name, "projector");
+    EXPECT_EQ(calibrationSteps("table")->front().name, "table");
+    EXPECT_FALSE(calibrationSteps("everything"));
+}
+
+TEST(CalibrationJob, ThisBuildNamesTheStepsWithoutEstimator) {
+    const std::optional<std::string> missing = missingEstimator(*calibrationSteps("full"));
+    ASSERT_TRUE(missing);
+    EXPECT_THAT(*missing, HasSubstr("projector step"));
+    EXPECT_THAT(*missing, HasSubstr("not part of this build"));
+    EXPECT_FALSE(missingEstimator(*calibrationSteps("table")));
+}
+
+TEST(CalibrationJob, OptionsAreRangeChecked) {
+    EXPECT_FALSE(CalibrationOptions().validate());
+    CalibrationOptions options;
+    options.pairsPerStep = 0;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("frames"));
+    options = CalibrationOptions();
+    options.cardHeightMm = -1;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("card_height_mm"));
+    options.cardHeightMm = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_TRUE(options.validate());
+}
+
+TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
+    std::vector<std::size_t> pairsSeen;
+    const std::vector<CalibrationStep> steps = {shiftingStep("first", 1.0, 0.2, pairsSeen),
+                                                shiftingStep("second", 10.0, 0.4, pairsSeen)};
+    CalibrationOptions options;
+    options.pairsPerStep = 3;
+    std::uint64_t nextIndex = 0;
+    std::vector<std::size_t> requested;
+    std::vector<ProgressEvent> progress;
+    const CalibrationOutcome outcome = runCalibration(
+        steps, options, std::nullopt,
+        [&](std::size_t pairs) {
+            requested.push_back(pairs);
+            nextIndex += 2 * pairs;
+            return std::optional(pairsNumbered(pairs, nextIndex));
+        },
+        [&](const std::string& step, double fraction, const std::string& message) {
+            progress.push_back({step, fraction, message});
+        });
+    ASSERT_TRUE(outcome.ok) << outcome.message;
+    EXPECT_EQ(requested, (std::vector<std::size_t>{3, 3}));
+    EXPECT_EQ(pairsSeen, (std::vector<std::size_t>{3, 3}));
+    ASSERT_TRUE(outcome.calibration);
+    EXPECT_DOUBLE_EQ(outcome.calibration->displayToProjector(0, 2), 11.0);
+    EXPECT_DOUBLE_EQ(outcome.rmsPx, 0.4);
+    ASSERT_FALSE(progress.empty());
+    EXPECT_EQ(progress.front().step, "first");
+    EXPECT_EQ(progress.front().message, "first prompt");
+    EXPECT_DOUBLE_EQ(progress.front().fraction, 0.0);
+    EXPECT_DOUBLE_EQ(progress.back().fraction, 1.0);
+    for (std::size_t i = 1; i < progress.size(); ++i)
+        EXPECT_GE(progress[i].fraction, progress[i - 1].fraction);
+}
+
+TEST(CalibrationJob, AFailingStepStopsTheJobWithoutACalibration) {
+    std::vector<std::size_t> pairsSeen;
+    CalibrationStep failing = shiftingStep("first", 1.0, 0.2, pairsSeen);
+    failing.estimator = [](const std::vector<core::FramePair>&, const std::optional<core::Calibration>&,
+                           const CalibrationOptions&) {
+        EstimateResult result;
+        result.problem = "no chessboard in view";
+        return result;
+    };
+    const std::vector<CalibrationStep> steps = {failing, shiftingStep("second", 10.0, 0.4, pairsSeen)};
+    const CalibrationOutcome outcome = runCalibration(
+        steps, CalibrationOptions(), test::paperLikeCalibration(),
+        [](std::size_t pairs) { return std::optional(pairsNumbered(pairs, 0)); },
+        [](const std::string&, double, const std::string&) {});
+    EXPECT_FALSE(outcome.ok);
+    EXPECT_FALSE(outcome.calibration);
+    EXPECT_THAT(outcome.message, HasSubstr("first step failed: no chessboard in view"));
+    EXPECT_TRUE(pairsSeen.empty());
+}
+
+TEST(CalibrationJob, NoFramesIsAFailure) {
+    std::vector<std::size_t> pairsSeen;
+    const CalibrationOutcome outcome = runCalibration(
+        {shiftingStep("only", 1.0, 0.1, pairsSeen)}, CalibrationOptions(), std::nullopt,
+        [](std::size_t) { return std::optional<std::vector<core::FramePair>>(); },
+        [](const std::string&, double, const std::string&) {});
+    EXPECT_FALSE(outcome.ok);
+    EXPECT_THAT(outcome.message, HasSubstr("got no camera frames"));
+    EXPECT_TRUE(pairsSeen.empty());
+}
+
+}  // namespace
+}  // namespace everytouch::service

@@ -1,0 +1,133 @@
+#include "service/config.h"
+
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/input_error.h"
+#include "support/temp_dir.h"
+
+namespace everytouch::service {
+namespace {
+
+using ::testing::HasSubstr;
+
+void write(const std::filesystem::path& path, const std::string& text) {
+    std::filesystem::create_directories(path.parent_path());
+    std::ofstream(path) << text;
+}
+
+std::string loadError(const std::filesystem::path& path) {
+    try {
+        loadConfig(path, true);
+    } catch (const io::InputError& error) {
+        return error.what();
+    }
+    return "no error";
+}
+
+TEST(Config, MissingDefaultFileGivesDefaults) {
+    test::TempDir dir;
+    EXPECT_EQ(loadConfig(dir / "everytouchd.conf", false), DaemonConfig());
+}
+
+TEST(Config, MissingRequiredFileIsNamed) {
+    test::TempDir dir;
+    EXPECT_THAT(loadError(dir / "absent.conf"), HasSubstr("absent.conf: no such file"));
+}
+
+TEST(Config, ReadsEveryKey) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf",
+          "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
+          "[Calibration]\nPath=/var/lib/et/cal.yml\n");
+    const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
+    EXPECT_EQ(config.rig, "replay:/srv/rec");
+    EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
+    EXPECT_EQ(config.uinput, false);
+    EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
+}
+
+TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Touch]\nHeightMm=5\n[Camera]\nRig=aravis\n");
+    write(dir / "everytouchd.conf.d" / "20-late.conf", "[Touch]\nHeightMm=9\n");
+    write(dir / "everytouchd.conf.d" / "10-early.conf", "[Touch]\nHeightMm=1\n[Camera]\nRig=\n");
+    write(dir / "everytouchd.conf.d" / "ignored.txt", "this is not a config file");
+    const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
+    EXPECT_DOUBLE_EQ(config.touchHeightMm, 9.0);
+    EXPECT_EQ(config.rig, "");
+}
+
+TEST(Config, UnknownKeyNamesFileLineAndKey) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Touch]\n\nHeight=3\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("everytouchd.conf:3: [Touch] Height: unknown key; [Touch] knows HeightMm="));
+}
+
+TEST(Config, UnknownSectionIsNamed) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Camera]\nRig=sim\n[Display]\nWidth=3\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("everytouchd.conf:4: [Display] Width: unknown section [Display]"));
+}
+
+TEST(Config, KeyOutsideASectionIsAnError) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "Rig=sim\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("everytouchd.conf:1: Rig: not inside a [Section]"));
+}
+
+TEST(Config, BadValuesSayWhatIsAccepted) {
+    test::TempDir dir;
+    const std::pair<const char*, const char*> cases[] = {
+        {"[Touch]\nHeightMm=three\n",
+         ":2: [Touch] HeightMm: expected a number of millimetres, found \"three\""},
+        {"[Touch]\nHeightMm=31\n", ":2: [Touch] HeightMm: must be from 0 to 30 mm, found 31"},
+        {"[Touch]\nHeightMm=-0.5\n", ":2: [Touch] HeightMm: must be from 0 to 30 mm"},
+        {"[Touch]\nHeightMm=nan\n", ":2: [Touch] HeightMm: expected a number"},
+        {"[Output]\nUinput=maybe\n", ":2: [Output] Uinput: expected yes or no, found \"maybe\""},
+        {"[Calibration]\nPath=calibration.yml\n", ":2: [Calibration] Path: expected an absolute path"},
+        {"[Camera]\nRig=webcam\n", ":2: [Camera] Rig: expected sim[:SCENARIO]"},
+    };
+    for (const auto& [text, expected] : cases) {
+        write(dir / "everytouchd.conf", text);
+        EXPECT_THAT(loadError(dir / "everytouchd.conf"), HasSubstr(expected)) << text;
+    }
+}
+
+TEST(Config, MalformedLineIsNamedByLine) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Touch]\nHeightMm=2\n[Camera\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("everytouchd.conf:3: expected [Section], Key=value, a comment or an empty line"));
+}
+
+TEST(Config, TheFirstProblemIsReported) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Touch]\nnonsense line\nHeight=3\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"), HasSubstr("everytouchd.conf:2: expected [Section]"));
+    write(dir / "everytouchd.conf", "[Touch]\nHeight=3\nnonsense line\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("everytouchd.conf:2: [Touch] Height: unknown key"));
+}
+
+TEST(Config, OverlongLineIsAnError) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Calibration]\nPath=/" + std::string(400, 'a') + "\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"), HasSubstr("everytouchd.conf:2: line longer than"));
+}
+
+TEST(Config, ProblemInADropInNamesTheDropIn) {
+    test::TempDir dir;
+    write(dir / "everytouchd.conf", "[Touch]\nHeightMm=5\n");
+    write(dir / "everytouchd.conf.d" / "50-site.conf", "[Touch]\n# fine so far\nHeightMm=50\n");
+    EXPECT_THAT(loadError(dir / "everytouchd.conf"),
+                HasSubstr("50-site.conf:3: [Touch] HeightMm: must be from"));
+}
+
+}  // namespace
+}  // namespace everytouch::service
