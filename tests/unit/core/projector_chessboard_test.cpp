@@ -129,7 +129,9 @@ TEST(ProjectorChessboard, FrameWithoutABoardFailsQuickly) {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     EXPECT_FALSE(detection.success);
     EXPECT_THAT(detection.message, HasSubstr("no projected chessboard"));
-    EXPECT_LT(elapsedMs, 50.0);
+    // Without CALIB_CB_FAST_CHECK the classic finder spends about 7 s on such a frame; with it a few ms (tens
+    // under the sanitizers). The bound separates the two on a loaded machine.
+    EXPECT_LT(elapsedMs, 500.0);
 }
 
 TEST(ProjectorChessboard, RejectsAnImageOfTheWrongType) {
