@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/edge_profile.h"
+#include "core/gray_frame.h"
 
 namespace everytouch::core {
 
@@ -229,16 +230,11 @@ ChessboardDetection detectProjectedChessboard(const cv::Mat& cameraImage, const 
         detection.message = *problem;
         return detection;
     }
-    if (cameraImage.empty() || cameraImage.depth() != CV_8U ||
-        (cameraImage.channels() != 1 && cameraImage.channels() != 3)) {
-        detection.message = "camera frame: expected an 8-bit gray or BGR image";
+    cv::Mat gray;
+    if (auto problem = grayFrame(cameraImage, gray)) {
+        detection.message = *problem;
         return detection;
     }
-    cv::Mat gray;
-    if (cameraImage.channels() == 3)
-        cv::cvtColor(cameraImage, gray, cv::COLOR_BGR2GRAY);
-    else
-        gray = cameraImage;
 
     std::vector<cv::Point2f> corners;
     // Without the fast check the finder spends seconds on a frame that has no board.

@@ -10,6 +10,7 @@
 
 #include "core/edge_profile.h"
 #include "core/geometry.h"
+#include "core/gray_frame.h"
 
 namespace everytouch::core {
 
@@ -234,16 +235,11 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         detection.message = *problem;
         return detection;
     }
-    if (cameraImage.empty() || cameraImage.depth() != CV_8U ||
-        (cameraImage.channels() != 1 && cameraImage.channels() != 3)) {
-        detection.message = "camera frame: expected an 8-bit gray or BGR image";
+    cv::Mat gray;
+    if (auto problem = grayFrame(cameraImage, gray)) {
+        detection.message = *problem;
         return detection;
     }
-    cv::Mat gray;
-    if (cameraImage.channels() == 3)
-        cv::cvtColor(cameraImage, gray, cv::COLOR_BGR2GRAY);
-    else
-        gray = cameraImage;
 
     // Dark against the local surroundings. The window spans a quarter of the frame, several times a stripe's
     // width; a larger dark rectangle shows up as a ring whose outline is still the rectangle.
