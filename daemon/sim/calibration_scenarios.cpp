@@ -262,8 +262,7 @@ double PairCalibrationScenario::cycleSeconds() const {
 }
 
 SceneState PairCalibrationScenario::at(double seconds) const {
-    const double cycle = cycleSeconds();
-    const double local = seconds - std::floor(seconds / cycle) * cycle;
+    const double local = std::max(seconds, 0.0);
     SceneState state;
     state.content = ContentKind::White;
     const int last = static_cast<int>(poses_.size()) - 1;

@@ -84,7 +84,7 @@ private:
 
 // The one-time pair calibration as a user performs it: the card on the bare table, then a white board held in
 // five tilts, the card lying on it beside the projected chessboard, each pose held still and the board moved
-// between them. The cycle ends on the last pose, which is held until the next cycle starts.
+// between them. The session plays once and then holds the last pose.
 class PairCalibrationScenario final : public Scenario {
 public:
     struct Pose {
@@ -103,7 +103,7 @@ public:
     std::vector<Props> stillProps() const override;
     // The table pose first, then the board's five.
     const std::vector<Pose>& poses() const { return poses_; }
-    // Start and end of the still interval of pose k, seconds into a cycle.
+    // Start and end of the still interval of pose k, seconds into the session (the last one lasts).
     double holdStart(int pose) const;
     double holdEnd(int pose) const { return holdStart(pose) + kHoldSeconds; }
 
