@@ -23,7 +23,7 @@ Eigen::Isometry3d blend(const Eigen::Isometry3d& from, const Eigen::Isometry3d& 
     return pose;
 }
 
-constexpr double kSearchStepMm = 5.0;     // coarse grid of card places
+constexpr double kSearchStepMm = 8.0;     // coarse grid of card places, refined to 0.5 mm
 constexpr double kSearchReachMm = 230.0;  // from the panel centre's ray, along the surface
 constexpr double kBoardMarginMm = 8.0;    // board edge beyond the chessboard and the card: fingers hold it
 constexpr double kMaxViewDeg = 50.0;      // the steepest view of the card the scenarios allow
@@ -223,13 +223,13 @@ PairCalibrationScenario::PairCalibrationScenario(const ScenarioContext& context)
                      .card;
     poses_.push_back(table);
     // Five tilts about different axes, each at the lift in 40-80 mm (where the panel's centre ray meets the
-    // board) that leaves the card the most room. Their normals differ by at least 15 degrees from each other
+    // board) that leaves the card the most room. Their normals differ by at least 11 degrees from each other
     // and by 12 from the table's. The rig's camera looks at the far side of the table at about 45 degrees and
     // the card needs a view of it within kMaxViewDeg, so no board tilts its far side down much.
     struct Tilt {
         double axisDeg, tiltDeg;
     };
-    constexpr Tilt kTilts[5] = {{315.0, 25.0}, {45.0, 20.0}, {135.0, 12.5}, {270.0, 16.0}, {0.0, 25.0}};
+    constexpr Tilt kTilts[5] = {{315.0, 25.0}, {45.0, 20.0}, {225.0, 16.0}, {270.0, 16.0}, {180.0, 12.5}};
     for (const Tilt& tilt : kTilts) {
         Pose pose;
         pose.axisDeg = tilt.axisDeg + rng.uniform(-2.0, 2.0);
@@ -238,7 +238,7 @@ PairCalibrationScenario::PairCalibrationScenario(const ScenarioContext& context)
         const Eigen::Vector3d axis(std::cos(pose.axisDeg * M_PI / 180.0),
                                    std::sin(pose.axisDeg * M_PI / 180.0), 0);
         CardPlacement best;
-        for (double lift = 40.0; lift <= 80.0; lift += 5.0) {
+        for (double lift = 40.0; lift <= 80.0; lift += 10.0) {
             const Eigen::Isometry3d surface = Eigen::Translation3d(stage.panelCentreAt(lift)) *
                                               Eigen::AngleAxisd(pose.tiltDeg * M_PI / 180.0, axis);
             CardPlacement placement = placeCard(stage, surface, BoardProp().sizeMm, yawJitter);
