@@ -30,7 +30,8 @@ enum class SkinTone { Light, Medium, Tan, Dark };
 // into electrons with `sensitivity`.
 struct SimParameters {
     // --- session ---
-    std::string scenario = "demo";    // grid35, drag, multitouch, hover, palm, idle or demo
+    std::string scenario = "demo";    // grid35, drag, multitouch, hover, palm, idle, demo, table-setup,
+                                      // pair-calibration
     std::uint64_t seed = 1;           // every random choice (pattern, content, motion, noise) follows from it
     double startS = 0.0;              // the stream starts this many seconds into the session
     std::optional<double> durationS;  // the stream ends after this many seconds; endless when not set
