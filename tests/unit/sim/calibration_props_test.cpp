@@ -8,6 +8,7 @@
 #include "core/geometry.h"
 #include "core/projector_chessboard.h"
 #include "core/table_rectangle.h"
+#include "sim/rig_geometry.h"
 #include "sim/simulator.h"
 
 namespace everytouch::sim {
@@ -343,6 +344,52 @@ TEST(PairCalibrationScenario, ChessboardAndStripeOnEveryBoardPoseAgreeWithTheGeo
         RecordProperty("stripe_corner_error_px_pose" + std::to_string(k), std::to_string(error));
         EXPECT_LT(error, 0.3) << "pose " << k;
     }
+}
+
+TEST(Props, AHandOverTheBoardIsSeenAboveItAndShadowsIt) {
+    SimParameters p;
+    const core::Calibration calibration = rigCalibration(p);
+    Renderer renderer(p, calibration, randomPattern(p.projectorSize));
+    renderer.setContent(renderContent(ContentKind::White, calibration.displaySize, 1, 0));
+    const PairCalibrationScenario scenario({calibration, 1, 1.0});
+    const PairCalibrationScenario::Pose& pose = scenario.poses()[1];
+    renderer.setProps({pose.card, pose.board});
+
+    // An index finger pointing 30 mm above the middle of the board's lit part.
+    const Eigen::Isometry3d& face = pose.board->faceToTable;
+    Eigen::Vector3d lit = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& corner :
+         CalibrationStage(calibration, calibrationChessboard()).chessboardOn(face))
+        lit += corner / 4.0;
+    const Eigen::Isometry3d board = Eigen::Translation3d(lit - face.translation()) * face;
+    HandPose hand;
+    for (int f = 0; f < kFingerCount; ++f)
+        hand.fingers[f] = pointingJoints(static_cast<Finger>(f));
+    hand.place({0, 0, 0}, -90.0, 30.0);
+    movePadTo(hand, Finger::Index, board * Eigen::Vector3d(0, 0, 30.0));
+    const double exposure = renderer.meterExposureMs(p.ambientLux);
+    cv::Mat with, without;
+    FrameTruth truth, bare;
+    renderer.render({{hand}}, core::Polarity::Positive, p.ambientLux, exposure, 5, with, truth);
+    renderer.render({{}}, core::Polarity::Positive, p.ambientLux, exposure, 5, without, bare);
+    EXPECT_EQ(truth.props, bare.props);
+    ASSERT_GT(cv::countNonZero(truth.handMask), 1000);
+
+    // The board's visible heights in the truth; the hand above it.
+    const Eigen::Vector2d middle = project(calibration, board.translation());
+    EXPECT_NEAR(bare.visibleHeightMm.at<float>(static_cast<int>(middle.y()), static_cast<int>(middle.x())),
+                board.translation().z(), 1.0);
+    const FingertipTruth& index = truth.fingertips[static_cast<int>(Finger::Index)];
+    EXPECT_NEAR(index.pad.z(), (board * Eigen::Vector3d(0, 0, 30.0)).z(), 1e-6);
+
+    // Its shadow: board pixels outside the hand that lost most of the projector's light.
+    cv::Mat withGray, withoutGray;
+    cv::cvtColor(with, withGray, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(without, withoutGray, cv::COLOR_BGR2GRAY);
+    cv::Mat darker = (withoutGray - withGray) > 40;
+    darker.setTo(0, truth.handMask);
+    darker.setTo(0, bare.visibleHeightMm < 1.0f);  // the table
+    EXPECT_GT(cv::countNonZero(darker), 200);
 }
 
 }  // namespace
