@@ -573,7 +573,9 @@ void Renderer::buildScene(bool fine) {
             sceneAlbedo_.at<cv::Vec3f>(y, x) = cv::Vec3f(albedo.x(), albedo.y(), albedo.z());
             planeLabel_.at<uchar>(y, x) =
                 static_cast<uchar>(std::max_element(coverage.begin(), coverage.end()) - coverage.begin());
-            sceneHeight_.at<float>(y, x) = cast(x, y, tableAlbedo).height;
+            // The truth's height: the central ray (the only sample of a coarse cast).
+            sceneHeight_.at<float>(y, x) =
+                hits.size() == 1 ? hits.front().height : cast(x, y, tableAlbedo).height;
         }
     ambientTerm_ = sceneAlbedo_.mul(cv::Scalar(ambientBgr_.x(), ambientBgr_.y(), ambientBgr_.z()));
     blurIfNeeded(ambientTerm_, ambientBlurred_, parameters_.cameraDefocusPx);
