@@ -485,15 +485,7 @@ void Renderer::buildScene(bool fine) {
             planes_[faces.front().plane].shadowedByBoard = t > 0.0 && t < 1.0;
         }
     }
-    if (faces.empty()) {
-        cv::Mat ambientTerm = sceneAlbedo_.mul(cv::Scalar(ambientBgr_.x(), ambientBgr_.y(), ambientBgr_.z()));
-        ambientTerm_ = ambientTerm;
-        blurIfNeeded(ambientTerm_, ambientBlurred_, parameters_.cameraDefocusPx);
-        ++contentVersion_;
-        return;
-    }
-
-    cv::Rect region;
+    cv::Rect region;  // empty without props: the table as precomputed
     for (size_t k = 1; k < planes_.size(); ++k)
         region |= planes_[k].cameraBox;
     // Where each sample ray lands: the nearest face it hits inside its rectangle, else the table.
