@@ -7,7 +7,6 @@
 
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <thread>
 
 #include <opencv2/imgcodecs.hpp>
@@ -22,6 +21,7 @@
 #include "service/bus_names.h"
 #include "service/table_set_up_step.h"
 #include "support/coded_recording.h"
+#include "support/file_contents.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
 #include "support/process.h"
@@ -64,13 +64,6 @@ std::vector<std::string> property(const std::string& verb, const std::string& na
 
 std::vector<std::string> call(const std::string& method, const std::vector<std::string>& arguments = {}) {
     return concat(busctl({"call", bus::kBusName, bus::kObjectPath, bus::kInterface, method}), arguments);
-}
-
-std::string fileContents(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
 }
 
 // A recording long enough for any test (a minute at 10 frames/s), shared by the tests of one process.
@@ -589,7 +582,7 @@ TEST_F(ServiceTest, ReloadRejectsABadConfigurationAndAppliesAGoodOne) {
 
 TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     std::ofstream(dir_ / "calibration.yml") << "%YAML:1.0\n---\nformat: everytouch-calibration\nversion: 7\n";
-    const std::string before = fileContents(dir_ / "calibration.yml");
+    const std::string before = test::fileContents(dir_ / "calibration.yml");
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
     startDaemon();
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
@@ -597,7 +590,7 @@ TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration.yml: version: unsupported version"));
     const test::ProcessResult save = test::runProcess(call("SaveCalibration"));
     EXPECT_THAT(save.err, HasSubstr("There is no calibration to save"));
-    EXPECT_EQ(fileContents(dir_ / "calibration.yml"), before);
+    EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), before);
 }
 
 TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveOne) {
