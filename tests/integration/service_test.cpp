@@ -9,6 +9,7 @@
 #include <memory>
 #include <thread>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <gmock/gmock.h>
@@ -463,13 +464,21 @@ TEST_F(ServiceTest, AnUnprivilegedCallerCanReadButNotChangeAnything) {
 TEST_F(ServiceTest, SnapshotsArePngsOfWhatTheCameraSees) {
     startDaemon();
     const test::CodedImages images = test::codedImages(test::smallRig().calibration.cameraSize, 10);
-    for (const char* what : {"camera", "texture", "subtraction"}) {
+    for (const char* what : {"camera", "texture", "subtraction", "overlay"}) {
         const std::filesystem::path file = dir_ / (std::string(what) + ".png");
         const test::ProcessResult result =
             test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", what, file.string()});
         ASSERT_EQ(result.exitCode, 0) << result.err;
         const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
         ASSERT_EQ(image.size(), test::smallRig().calibration.cameraSize) << what;
+        if (std::string(what) == "overlay") {
+            // The recorded rig is calibrated: the projected display's outline is drawn in green.
+            ASSERT_EQ(image.type(), CV_8UC3);
+            cv::Mat green;
+            cv::inRange(image, cv::Scalar(0, 200, 0), cv::Scalar(60, 255, 60), green);
+            EXPECT_GT(cv::countNonZero(green), image.cols) << "no display outline";
+            continue;
+        }
         ASSERT_EQ(image.type(), CV_8UC1) << what;
         if (std::string(what) == "camera") {
             EXPECT_TRUE(cv::norm(image, images.positive, cv::NORM_INF) == 0.0 ||
