@@ -63,12 +63,12 @@ struct CardPlacement {
     double clearancePx = -std::numeric_limits<double>::infinity();  // CardClearance::least()
 };
 
-// The card's place on the surface (z = 0 of `surfaceToTable`) with the most clearance, turned by
-// `yawDeg` from one of the surface's axes. With `boardSize` the surface is a board of that size, placed to
-// carry both the chessboard and the card (a margin from its edges to hold it by) without touching the table;
-// no board fits when `board` is empty.
+// The card's place on the surface (z = 0 of `surfaceToTable`) with the most clearance, its long side along
+// one of the surface's axes turned by `yawJitterDeg`, and seen at most 50 degrees off its normal. With
+// `boardSize` the surface is a board of that size, placed to carry both the chessboard and the card (a margin
+// from its edges to hold it by) without touching the table; no board fits when `board` is empty.
 CardPlacement placeCard(const CalibrationStage& stage, const Eigen::Isometry3d& surfaceToTable,
-                        const std::optional<cv::Size2d>& boardSize, double yawDeg);
+                        const std::optional<cv::Size2d>& boardSize, double yawJitterDeg);
 
 class TableSetupScenario final : public Scenario {
 public:
