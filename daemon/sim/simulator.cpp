@@ -123,8 +123,8 @@ void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& trut
     const SceneState middle = scenario_->at(start + exposure / 2.0);
     showContent(middle);
     // Props in motion are cast with one sample per pixel at mid-exposure; still ones in full.
-    const bool still =
-        middle.props == scenario_->at(start).props && middle.props == scenario_->at(start + exposure).props;
+    const bool still = middle.props.empty() || (middle.props == scenario_->at(start).props &&
+                                                middle.props == scenario_->at(start + exposure).props);
     renderer_->setProps(middle.props, still);
     int instants = 1;
     if (parameters_.motionSamples > 1 && !middle.hands.empty()) {
