@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <opencv2/core.hpp>
 
@@ -96,6 +99,21 @@ CardPlacement placeCard(const CalibrationStage& stage, const Eigen::Isometry3d& 
 }
 
 namespace {
+
+// A placement the card fits in, or std::invalid_argument naming what leaves it no room.
+const CardPlacement& requireRoom(const CardPlacement& placement, const std::string& where, bool board) {
+    if ((board && !placement.board) || !(placement.clearancePx > 0.0)) {
+        char message[256];
+        std::snprintf(
+            message, sizeof message,
+            "%s: on this rig the card does not fit between the projected chessboard and the edges of "
+            "the projector's light and the camera's view%s (room: %.1f px)",
+            where.c_str(), board ? " on a board of 420 x 297 mm" : "",
+            std::max(placement.clearancePx, -999.0));
+        throw std::invalid_argument(message);
+    }
+    return placement;
+}
 
 cv::RNG scenarioRng(std::uint64_t seed, int id) {
     std::uint64_t state =
@@ -193,7 +211,9 @@ TableSetupScenario::TableSetupScenario(const ScenarioContext& context) {
     const CalibrationStage stage(context.calibration, calibrationChessboard());
     cv::RNG rng = scenarioRng(context.seed, 20);
     const Eigen::Isometry3d table(Eigen::Translation3d(stage.panelCentreAt(0.0)));
-    card_ = placeCard(stage, table, std::nullopt, rng.uniform(-kYawJitterDeg, kYawJitterDeg)).card;
+    card_ = requireRoom(placeCard(stage, table, std::nullopt, rng.uniform(-kYawJitterDeg, kYawJitterDeg)),
+                        "table-setup", false)
+                .card;
 }
 
 std::vector<Props> TableSetupScenario::stillProps() const {
@@ -218,9 +238,11 @@ PairCalibrationScenario::PairCalibrationScenario(const ScenarioContext& context)
     const CalibrationStage stage(context.calibration, calibrationChessboard());
     cv::RNG rng = scenarioRng(context.seed, 21);
     Pose table;
-    table.card = placeCard(stage, Eigen::Isometry3d(Eigen::Translation3d(stage.panelCentreAt(0.0))),
-                           std::nullopt, rng.uniform(-kYawJitterDeg, kYawJitterDeg))
-                     .card;
+    table.card =
+        requireRoom(placeCard(stage, Eigen::Isometry3d(Eigen::Translation3d(stage.panelCentreAt(0.0))),
+                              std::nullopt, rng.uniform(-kYawJitterDeg, kYawJitterDeg)),
+                    "pair-calibration, the card on the table", false)
+            .card;
     poses_.push_back(table);
     // Five tilts about different axes, each at the lift in 40-80 mm (where the panel's centre ray meets the
     // board) that leaves the card the most room. Their normals differ by at least 11 degrees from each other
@@ -247,6 +269,11 @@ PairCalibrationScenario::PairCalibrationScenario(const ScenarioContext& context)
                 pose.liftMm = lift;
             }
         }
+        char where[96];
+        std::snprintf(where, sizeof where,
+                      "pair-calibration, the board tilted %.0f degrees about %.0f degrees", pose.tiltDeg,
+                      pose.axisDeg);
+        requireRoom(best, where, true);
         pose.board = best.board;
         pose.card = best.card;
         poses_.push_back(pose);

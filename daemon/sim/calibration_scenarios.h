@@ -72,6 +72,7 @@ CardPlacement placeCard(const CalibrationStage& stage, const Eigen::Isometry3d& 
 
 class TableSetupScenario final : public Scenario {
 public:
+    // Throws std::invalid_argument when the rig leaves the card no room.
     explicit TableSetupScenario(const ScenarioContext& context);
     SceneState at(double seconds) const override;
     double cycleSeconds() const override { return 10.0; }
@@ -97,6 +98,7 @@ public:
     static constexpr double kHoldSeconds = 2.0;
     static constexpr double kMoveSeconds = 1.0;
 
+    // Throws std::invalid_argument when the rig leaves the card no room on the table or a tilted board.
     explicit PairCalibrationScenario(const ScenarioContext& context);
     SceneState at(double seconds) const override;
     double cycleSeconds() const override;

@@ -248,6 +248,19 @@ TEST(PairCalibrationScenario, PosesAreWhatTheCalibrationNeeds) {
     }
 }
 
+TEST(PairCalibrationScenario, ARigWithoutRoomForTheCardIsRefusedWithTheReason) {
+    SimParameters p;
+    p.scenario = "pair-calibration";
+    p.projectorFocalPx =
+        1100.0;  // a longer throw: the border around the chessboard gets narrower than the card
+    try {
+        Simulator simulator(p, randomPattern(p.projectorSize));
+        FAIL() << "expected std::invalid_argument";
+    } catch (const std::invalid_argument& error) {
+        EXPECT_NE(std::string(error.what()).find("the card does not fit"), std::string::npos) << error.what();
+    }
+}
+
 TEST(PairCalibrationScenario, HoldsSixStillScenesAndMovesBetweenThem) {
     SimParameters p;
     p.scenario = "pair-calibration";
