@@ -246,37 +246,55 @@ PairCalibrationScenario::PairCalibrationScenario(const ScenarioContext& context)
     poses_.push_back(table);
     // Five tilts about different axes, each at the lift in 40-80 mm (where the panel's centre ray meets the
     // board) that leaves the card the most room. Their normals differ by at least 11 degrees from each other
-    // and by 12 from the table's. The rig's camera looks at the far side of the table at about 45 degrees and
-    // the card needs a view of it within kMaxViewDeg, so no board tilts its far side down much.
+    // and from the table's. The rig's camera looks at the far side of the table at about 45 degrees and
+    // the card needs a view of it within kMaxViewDeg, so no board tilts its far side down much. Where a rig
+    // leaves the card less than kComfortPx at a nominal tilt, the tilt moves to where it has the most room
+    // (axis +-10 degrees, tilt +-5 within 12-30) while still differing by kMinTiltDifferenceDeg from the
+    // surfaces before it.
     struct Tilt {
         double axisDeg, tiltDeg;
     };
     constexpr Tilt kTilts[5] = {{315.0, 25.0}, {45.0, 20.0}, {225.0, 16.0}, {270.0, 16.0}, {180.0, 12.5}};
+    constexpr double kComfortPx = 2.0;
+    constexpr double kMinTiltDifferenceDeg = 11.0;
+    std::vector<Eigen::Vector3d> normals{Eigen::Vector3d::UnitZ()};
     for (const Tilt& tilt : kTilts) {
-        Pose pose;
-        pose.axisDeg = tilt.axisDeg + rng.uniform(-2.0, 2.0);
-        pose.tiltDeg = tilt.tiltDeg + rng.uniform(-0.5, 0.5);
+        const double axisJitter = rng.uniform(-2.0, 2.0), tiltJitter = rng.uniform(-0.5, 0.5);
         const double yawJitter = rng.uniform(-kYawJitterDeg, kYawJitterDeg);
-        const Eigen::Vector3d axis(std::cos(pose.axisDeg * M_PI / 180.0),
-                                   std::sin(pose.axisDeg * M_PI / 180.0), 0);
+        Pose pose;
         CardPlacement best;
-        for (double lift = 40.0; lift <= 80.0; lift += 10.0) {
-            const Eigen::Isometry3d surface = Eigen::Translation3d(stage.panelCentreAt(lift)) *
-                                              Eigen::AngleAxisd(pose.tiltDeg * M_PI / 180.0, axis);
-            CardPlacement placement = placeCard(stage, surface, BoardProp().sizeMm, yawJitter);
-            if (placement.board && placement.clearancePx > best.clearancePx) {
-                best = placement;
-                pose.liftMm = lift;
+        const auto tryTilt = [&](double axisDeg, double tiltDeg) {
+            const Eigen::Vector3d axis(std::cos(axisDeg * M_PI / 180.0), std::sin(axisDeg * M_PI / 180.0), 0);
+            const Eigen::Vector3d normal =
+                Eigen::AngleAxisd(tiltDeg * M_PI / 180.0, axis) * Eigen::Vector3d::UnitZ();
+            for (const Eigen::Vector3d& other : normals)
+                if (std::acos(std::min(1.0, normal.dot(other))) * 180.0 / M_PI < kMinTiltDifferenceDeg)
+                    return;
+            for (double lift = 40.0; lift <= 80.0; lift += 10.0) {
+                const Eigen::Isometry3d surface = Eigen::Translation3d(stage.panelCentreAt(lift)) *
+                                                  Eigen::AngleAxisd(tiltDeg * M_PI / 180.0, axis);
+                CardPlacement placement = placeCard(stage, surface, BoardProp().sizeMm, yawJitter);
+                if (placement.board && placement.clearancePx > best.clearancePx) {
+                    best = placement;
+                    pose.axisDeg = axisDeg, pose.tiltDeg = tiltDeg, pose.liftMm = lift;
+                }
             }
-        }
+        };
+        tryTilt(tilt.axisDeg + axisJitter, tilt.tiltDeg + tiltJitter);
+        if (!(best.clearancePx >= kComfortPx))
+            for (double axisStep : {-10.0, 0.0, 10.0})
+                for (double tiltStep : {-5.0, 0.0, 5.0})
+                    tryTilt(tilt.axisDeg + axisJitter + axisStep,
+                            std::clamp(tilt.tiltDeg + tiltJitter + tiltStep, 12.0, 30.0));
         char where[96];
         std::snprintf(where, sizeof where,
-                      "pair-calibration, the board tilted %.0f degrees about %.0f degrees", pose.tiltDeg,
-                      pose.axisDeg);
+                      "pair-calibration, the board tilted %.0f degrees about %.0f degrees", tilt.tiltDeg,
+                      tilt.axisDeg);
         requireRoom(best, where, true);
         pose.board = best.board;
         pose.card = best.card;
         poses_.push_back(pose);
+        normals.push_back(pose.board->faceToTable.linear().col(2));
     }
 }
 
