@@ -6,12 +6,15 @@
 
 namespace everytouch::service {
 
-std::unique_ptr<io::FrameSource> openFrameSource(const io::RigSpec& spec, bool fast) {
+OpenedRig openRig(const io::RigSpec& spec, bool fast) {
+    OpenedRig rig;
     switch (spec.kind) {
         case io::RigSpec::Kind::Replay:
-            return std::make_unique<io::ReplaySource>(spec.target, !fast);
+            rig.source = std::make_unique<io::ReplaySource>(spec.target, !fast);
+            return rig;
         case io::RigSpec::Kind::Sim:
-            return std::make_unique<io::SimSource>(spec, !fast);
+            rig.source = std::make_unique<io::SimSource>(spec, !fast);
+            return rig;
         case io::RigSpec::Kind::Aravis:
         case io::RigSpec::Kind::V4l2:
             throw io::InputError("--rig " + spec.toString(), "",

@@ -44,6 +44,25 @@ core::ChessboardOptions tableSetUpChessboard() {
     return options;
 }
 
+EstimateResult setUpTableStep(const StepContext& context) {
+    if (!context.current)
+        return failure(
+            "it needs the projector-camera pair's calibration (both lenses and their pose), and "
+            "there is none; run the projector step first");
+    cv::Mat board;
+    core::renderProjectorChessboard(tableSetUpChessboard(), context.projectorSize, board);
+    context.show(board);
+    context.progress(
+        0.0,
+        "The projector shows a chessboard: keep the table clear and lay the card flat in the white "
+        "border below the board");
+    const std::optional<std::vector<core::FramePair>> pairs = context.capture(context.options.pairsPerStep);
+    if (!pairs)
+        return failure("it got no camera frames");
+    context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
+    return setUpTableFromPairs(*pairs, context.current, context.options);
+}
+
 EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options) {

@@ -24,4 +24,8 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options);
 
+// The table step as the calibration job runs it: shows the board (tableSetUpChessboard) on white, captures
+// options.pairsPerStep pairs and sets the table up from them (setUpTableFromPairs).
+EstimateResult setUpTableStep(const StepContext& context);
+
 }  // namespace everytouch::service
