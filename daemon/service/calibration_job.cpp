@@ -67,10 +67,16 @@ CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
     for (std::size_t i = 0; i < steps.size(); ++i) {
         const CalibrationStep& step = steps[i];
         const double begun = stepShare * static_cast<double>(i);
-        const StepContext context{
-            options, current, projectorSize, capture, show, [&](double fraction, const std::string& message) {
-                progress(step.name, begun + stepShare * std::clamp(fraction, 0.0, 1.0), message);
-            }};
+        const StepContext context{options,
+                                  current,
+                                  projectorSize,
+                                  capture,
+                                  show,
+                                  [&](double fraction, const std::string& message) {
+                                      progress(step.name, begun + stepShare * std::clamp(fraction, 0.0, 1.0),
+                                               message);
+                                  },
+                                  i > 0};
         EstimateResult result = step.run(context);
         if (!result.calibration) {
             outcome.message = "the " + step.name + " step failed: " + result.problem;

@@ -54,6 +54,8 @@ struct StepContext {
     ShowFunction show;
     // Progress within the step: fraction 0..1 of the step, a sentence for the user.
     std::function<void(double fraction, const std::string& message)> progress;
+    // Another step ran before this one in the same job: the scene still shows what that step needed.
+    bool followsAnotherStep = false;
 };
 
 using StepRunner = std::function<EstimateResult(const StepContext& context)>;

@@ -6,11 +6,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/code_image.h"
+#include "core/gray_frame.h"
 #include "core/keystone.h"
 #include "core/plane_view.h"
 #include "core/projector_camera_pair.h"
 #include "core/table_rectangle.h"
 #include "core/table_setup.h"
+#include "service/pose_capture.h"
 
 namespace everytouch::service {
 
@@ -36,6 +38,36 @@ EstimateResult failure(const std::string& problem) {
     return result;
 }
 
+// Waits, pair by pair, until the scene has changed and then held still; the problem when it does not within
+// the options' view time-out.
+std::optional<std::string> awaitNewStillScene(const StepContext& context) {
+    StillnessTracker stillness{PoseCaptureOptions()};
+    cv::Mat subtraction, texture, gray;
+    bool changed = false;
+    std::optional<std::int64_t> startUs;
+    while (true) {
+        const std::optional<std::vector<core::FramePair>> pairs = context.capture(1);
+        if (!pairs || pairs->empty())
+            return "it got no camera frames";
+        const core::FramePair& pair = pairs->front();
+        core::computeSubtractionAndTexture(pair, subtraction, texture);
+        if (const std::optional<std::string> problem = core::grayFrame(texture, gray))
+            return "the camera frames: " + *problem;
+        const std::int64_t nowUs = pair.latest().timestampUs;
+        const StillnessTracker::State state = stillness.offer(gray, nowUs);
+        if (!startUs) {
+            startUs = nowUs;
+            continue;
+        }
+        changed = changed || state == StillnessTracker::State::Changed;
+        if (changed && state == StillnessTracker::State::Still)
+            return std::nullopt;
+        if ((nowUs - *startUs) * 1e-6 > context.options.viewTimeoutS)
+            return "the scene did not change and hold still again within " +
+                   std::to_string(static_cast<int>(context.options.viewTimeoutS)) + " s";
+    }
+}
+
 }  // namespace
 
 core::ChessboardOptions tableSetUpChessboard() {
@@ -52,10 +84,17 @@ EstimateResult setUpTableStep(const StepContext& context) {
     cv::Mat board;
     core::renderProjectorChessboard(tableSetUpChessboard(), context.projectorSize, board);
     context.show(board);
-    context.progress(
-        0.0,
-        "The projector shows a chessboard: keep the table clear and lay the card flat in the white "
-        "border below the board");
+    const std::string prompt =
+        "The projector shows a chessboard: keep the table clear and lay the card flat in the white border "
+        "below the board";
+    if (context.followsAnotherStep) {
+        // The scene still shows the previous step's last pose: wait until it has changed and holds still.
+        context.progress(0.0, "Take the board away. " + prompt);
+        if (const std::optional<std::string> problem = awaitNewStillScene(context))
+            return failure(*problem);
+    } else {
+        context.progress(0.0, prompt);
+    }
     const std::optional<std::vector<core::FramePair>> pairs = context.capture(context.options.pairsPerStep);
     if (!pairs)
         return failure("it got no camera frames");
