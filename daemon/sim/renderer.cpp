@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -122,7 +124,6 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
     projectorTranslation_ =
         (calibration.projectorMatrix * calibration.tableToProjector.translation()).cast<float>();
     cameraToProjector_ = calibration.cameraToProjectorHomography(0.0);
-    projectorToCamera_ = cameraToProjector_.inverse();
 
     const Eigen::Matrix3d displayToTable = calibration.displayToTableHomography();
     const Eigen::Vector2d centre = core::applyHomography(
@@ -178,10 +179,11 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
             tableIncidence_.at<float>(y, x) =
                 static_cast<float>(referenceDistance2_ / r2 * cosine / referenceCosine_);
         }
-    const Eigen::Vector3f ambient = toBgr(p.ambientColour.cast<float>());
-    ambientBgr_ = ambient;
-    ambientTerm_ = albedo_.mul(cv::Scalar(ambient.x(), ambient.y(), ambient.z()));
-    blurIfNeeded(ambientTerm_, ambientBlurred_, p.cameraDefocusPx);
+    ambientBgr_ = toBgr(p.ambientColour.cast<float>());
+    cv::Mat incidence3;
+    cv::merge(std::vector<cv::Mat>{tableIncidence_, tableIncidence_, tableIncidence_}, incidence3);
+    tableWeight_ = albedo_.mul(incidence3);
+    buildScene(true);
 
     const Eigen::Vector3f skin = skinReflectance(p.skinTone);
     skinBgr_ = toBgr(skin);
@@ -194,13 +196,35 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
     hitIndex_ = cv::Mat(cameraSize, CV_16SC1, cv::Scalar(-1));
 }
 
-double Renderer::meterExposureMs(double ambientLux) const {
+double Renderer::meterExposureMs(double ambientLux, const std::vector<Props>& props) const {
     const cv::Scalar albedo = cv::mean(albedo_);
     const Eigen::Vector3f& ambient = ambientBgr_;
     double dnPerMs = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        const double radiance = albedo[c] * (parameters_.projectorWhiteLux + ambientLux * ambient[c]);
-        dnPerMs = std::max(dnPerMs, radiance * sensor_.dnPerLux(c, 1.0));
+    const auto meter = [&](const Eigen::Vector3f& reflectance, double projectorLux) {
+        for (int c = 0; c < 3; ++c) {
+            const double radiance = reflectance[c] * (projectorLux + ambientLux * ambient[c]);
+            dnPerMs = std::max(dnPerMs, radiance * sensor_.dnPerLux(c, 1.0));
+        }
+    };
+    meter(Eigen::Vector3f(static_cast<float>(albedo[0]), static_cast<float>(albedo[1]),
+                          static_cast<float>(albedo[2])),
+          parameters_.projectorWhiteLux);
+    // A prop's face nearer to the projector, or facing it more squarely, is lit more than the table.
+    const auto meterFace = [&](const Eigen::Vector3d& centre, const Eigen::Vector3d& normal,
+                               const Eigen::Vector3f& reflectance) {
+        const Eigen::Vector3d toProjector = projectorCentre_ - centre;
+        const double r2 = toProjector.squaredNorm();
+        const double cosine = std::max(0.0, normal.dot(toProjector) / std::sqrt(r2));
+        meter(reflectance,
+              parameters_.projectorWhiteLux * referenceDistance2_ / r2 * cosine / referenceCosine_);
+    };
+    for (const Props& scene : props) {
+        if (scene.card)
+            meterFace(scene.card->faceToTable * Eigen::Vector3d(kCardLengthMm / 2, kCardWidthMm / 2, 0),
+                      scene.card->faceToTable.linear().col(2), kCardAlbedo);
+        if (scene.board)
+            meterFace(scene.board->faceToTable.translation(), scene.board->faceToTable.linear().col(2),
+                      kBoardAlbedo);
     }
     if (dnPerMs <= 0.0)
         return parameters_.maxExposureMs;
@@ -210,12 +234,47 @@ double Renderer::meterExposureMs(double ambientLux) const {
 
 void Renderer::setContent(const cv::Mat& displayContent) {
     CV_Assert(displayContent.type() == CV_8UC3 && displayContent.size() == calibration_.displaySize);
+    cv::warpPerspective(displayContent, panelContent_, toCv(calibration_.displayToProjector),
+                        calibration_.projectorSize, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                        cv::Scalar::all(0));
+    if (projectorImage_.empty())
+        showPanelImage(panelContent_);
+}
+
+void Renderer::setProjectorImage(const cv::Mat& projectorImage) {
+    if (projectorImage.empty()) {
+        if (projectorImage_.empty())
+            return;
+        projectorImage_.release();
+        if (!panelContent_.empty()) {
+            showPanelImage(panelContent_);
+        } else {
+            panelLight_[0].release(), panelLight_[1].release();  // no content yet: setContent must come
+            projectedValid_[0] = projectedValid_[1] = false;
+        }
+        return;
+    }
+    if (projectorImage.size() != calibration_.projectorSize ||
+        (projectorImage.type() != CV_8UC1 && projectorImage.type() != CV_8UC3))
+        throw std::invalid_argument("projector image: expected an 8-bit gray or BGR image of " +
+                                    std::to_string(calibration_.projectorSize.width) + "x" +
+                                    std::to_string(calibration_.projectorSize.height) + " pixels, got " +
+                                    std::to_string(projectorImage.cols) + "x" +
+                                    std::to_string(projectorImage.rows) + " with " +
+                                    std::to_string(projectorImage.channels()) + " channel(s) of type " +
+                                    std::to_string(projectorImage.depth()));
+    if (projectorImage.type() == CV_8UC1)
+        cv::cvtColor(projectorImage, projectorImage_, cv::COLOR_GRAY2BGR);
+    else
+        projectorImage.copyTo(projectorImage_);
+    showPanelImage(projectorImage_);
+}
+
+void Renderer::showPanelImage(const cv::Mat& panelImage) {
     const SimParameters& p = parameters_;
-    const cv::Size cameraSize = calibration_.cameraSize, panelSize = calibration_.projectorSize;
-    cv::Mat panelContent, images[2];
-    cv::warpPerspective(displayContent, panelContent, toCv(calibration_.displayToProjector), panelSize,
-                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-    core::embedCode(panelContent, pattern_, p.delta, images[0], images[1]);
+    const cv::Size cameraSize = calibration_.cameraSize;
+    cv::Mat images[2];
+    core::embedCode(panelImage, pattern_, p.delta, images[0], images[1]);
 
     // Projector transfer: digital level -> light, as a fraction of white.
     cv::Mat transfer(1, 256, CV_32F);
@@ -232,32 +291,12 @@ void Renderer::setContent(const cv::Mat& displayContent) {
                                                  core::applyHomography(cameraToProjector_, cameraCentre));
     const double direct2 = p.projectorDefocusPx * p.projectorDefocusPx + footprint * footprint / 12.0;
 
-    const int n = p.pixelSamples;
     cv::Mat& light = work_[0];
-    cv::Mat& blurred = work_[1];
-    cv::Mat& sample = work_[2];
-    cv::Mat& accumulated = work_[3];
     for (int polarity = 0; polarity < 2; ++polarity) {
         cv::LUT(images[polarity], transfer, light);
         light = light.mul(panelFalloff_);
-        // The table: projector defocus, then the exact integral over each camera pixel by n x n samples.
-        blurIfNeeded(light, blurred, p.projectorDefocusPx);
-        accumulated = cv::Mat::zeros(cameraSize, CV_32FC3);
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j) {
-                Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
-                offset(0, 2) = (i + 0.5) / n - 0.5, offset(1, 2) = (j + 0.5) / n - 0.5;
-                cv::warpPerspective(blurred, sample, toCv(cameraToProjector_ * offset), cameraSize,
-                                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
-                                    cv::Scalar::all(0));
-                accumulated += sample;
-            }
-        accumulated *= 1.0 / (n * n);
-        cv::Mat incidence3;
-        cv::merge(std::vector<cv::Mat>{tableIncidence_, tableIncidence_, tableIncidence_}, incidence3);
-        projected_[polarity] = accumulated.mul(albedo_).mul(incidence3);
-        blurIfNeeded(projected_[polarity], projectedBlurred_[polarity], p.cameraDefocusPx);
-        ++contentVersion_;
+        blurIfNeeded(light, panelLight_[polarity], p.projectorDefocusPx);
+        projectLight(polarity);
 
         // Skin: part of the light is reflected at the surface, the rest leaves after spreading under the skin
         // (red farthest). Both seen through the camera pixel's footprint.
@@ -275,6 +314,270 @@ void Renderer::setContent(const cv::Mat& displayContent) {
         cv::addWeighted(direct, 1.0 - p.skinScatterFraction, scattered, p.skinScatterFraction, 0.0,
                         skinLight_[polarity]);
     }
+}
+
+void Renderer::projectLight(int polarityIndex) {
+    const SimParameters& p = parameters_;
+    const cv::Size cameraSize = calibration_.cameraSize;
+    // Each plane: the projector's light through its homography, integrated over each camera pixel by n x n
+    // samples, times what the plane reflects of it there.
+    const int n = propsFine_ ? p.pixelSamples : 1;
+    cv::Mat& shadowed = work_[1];
+    cv::Mat& sample = work_[2];
+    cv::Mat& accumulated = work_[3];
+    cv::Mat& projected = projected_[polarityIndex];
+    projected.create(cameraSize, CV_32FC3);
+    projected.setTo(cv::Scalar::all(0));
+    if (props_.board) {
+        cv::Mat shadow3;
+        cv::merge(std::vector<cv::Mat>{boardShadow_, boardShadow_, boardShadow_}, shadow3);
+        shadowed = panelLight_[polarityIndex] - panelLight_[polarityIndex].mul(shadow3);
+    }
+    for (const ScenePlane& plane : planes_) {
+        const cv::Rect& box = plane.cameraBox;
+        if (box.area() == 0)
+            continue;
+        const cv::Mat& light = plane.shadowedByBoard ? shadowed : panelLight_[polarityIndex];
+        accumulated.create(box.size(), CV_32FC3);
+        accumulated.setTo(cv::Scalar::all(0));
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                Eigen::Matrix3d offset = Eigen::Matrix3d::Identity();
+                offset(0, 2) = box.x + (i + 0.5) / n - 0.5, offset(1, 2) = box.y + (j + 0.5) / n - 0.5;
+                cv::warpPerspective(light, sample, toCv(plane.cameraToProjector * offset), box.size(),
+                                    cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
+                                    cv::Scalar::all(0));
+                accumulated += sample;
+            }
+        cv::Mat target = projected(box);
+        cv::scaleAdd(accumulated.mul(plane.weight), 1.0 / (n * n), target, target);
+    }
+    blurIfNeeded(projected, projectedBlurred_[polarityIndex], p.cameraDefocusPx);
+    projectedValid_[polarityIndex] = true;
+    ++contentVersion_;
+}
+
+void Renderer::setProps(const Props& props, bool fine) {
+    if (props == props_ && fine == propsFine_)
+        return;
+    props_ = props;
+    buildScene(fine);
+    if (panelLight_[0].empty())
+        return;
+    projectedValid_[0] = projectedValid_[1] = false;
+    if (fine) {
+        projectLight(0);
+        projectLight(1);
+    }
+}
+
+namespace {
+
+// A rectangle of a prop's face, for ray casting.
+struct FaceRect {
+    Eigen::Vector3d origin, xAxis, yAxis, normal;  // table frame; axes are unit vectors
+    double x0, x1, y0, y1;                         // extent along the axes, mm
+
+    static FaceRect of(const Eigen::Isometry3d& faceToTable, double x0, double x1, double y0, double y1) {
+        const Eigen::Matrix3d r = faceToTable.rotation();
+        return {faceToTable.translation(), r.col(0), r.col(1), r.col(2), x0, x1, y0, y1};
+    }
+    // Ray parameter of the hit with the face's plane (may be outside the rectangle); infinity when parallel.
+    double planeHit(const Eigen::Vector3d& from, const Eigen::Vector3d& direction) const {
+        const double along = normal.dot(direction);
+        return std::abs(along) < 1e-12 ? std::numeric_limits<double>::infinity()
+                                       : normal.dot(origin - from) / along;
+    }
+    bool contains(const Eigen::Vector3d& point) const {
+        const Eigen::Vector3d d = point - origin;
+        const double x = xAxis.dot(d), y = yAxis.dot(d);
+        return x >= x0 && x <= x1 && y >= y0 && y <= y1;
+    }
+};
+
+// A plane's homography from its own 2-D frame (mm) to a device's pixels.
+Eigen::Matrix3d planeToPixels(const Eigen::Matrix3d& intrinsics, const Eigen::Isometry3d& tableToDevice,
+                              const Eigen::Isometry3d& faceToTable) {
+    const Eigen::Isometry3d faceToDevice = tableToDevice * faceToTable;
+    Eigen::Matrix3d m;
+    m.col(0) = faceToDevice.rotation().col(0);
+    m.col(1) = faceToDevice.rotation().col(1);
+    m.col(2) = faceToDevice.translation();
+    return intrinsics * m;
+}
+
+}  // namespace
+
+void Renderer::buildScene(bool fine) {
+    propsFine_ = fine;
+    const cv::Size cameraSize = calibration_.cameraSize;
+    const cv::Rect whole(0, 0, cameraSize.width, cameraSize.height);
+    planes_.resize(1);
+    ScenePlane& table = planes_[0];
+    table.cameraToProjector = cameraToProjector_;
+    table.cameraBox = whole;
+    tableWeight_.copyTo(table.weight);
+    table.shadowedByBoard = props_.board.has_value();
+    albedo_.copyTo(sceneAlbedo_);
+    sceneHeight_ = cv::Mat::zeros(cameraSize, CV_32FC1);
+    planeLabel_ = cv::Mat::zeros(cameraSize, CV_8UC1);
+
+    // The props' faces, nearest first where they lie on each other: a card on the board lies above it.
+    struct Face {
+        FaceRect rect;
+        int plane;  // index into planes_
+        Eigen::Vector3f albedo;
+        std::optional<FaceRect> stripe;
+    };
+    std::vector<Face> faces;
+    const auto addPlane = [&](const Eigen::Isometry3d& faceToTable,
+                              const std::array<Eigen::Vector3d, 4>& corners) {
+        ScenePlane plane;
+        plane.cameraToProjector =
+            planeToPixels(calibration_.projectorMatrix, calibration_.tableToProjector, faceToTable) *
+            planeToPixels(calibration_.cameraMatrix, calibration_.tableToCamera, faceToTable).inverse();
+        double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+        for (const Eigen::Vector3d& corner : corners) {
+            const Eigen::Vector3d q = calibration_.cameraMatrix * (calibration_.tableToCamera * corner);
+            minX = std::min(minX, q.x() / q.z()), maxX = std::max(maxX, q.x() / q.z());
+            minY = std::min(minY, q.y() / q.z()), maxY = std::max(maxY, q.y() / q.z());
+        }
+        plane.cameraBox =
+            cv::Rect(static_cast<int>(std::floor(minX)) - 1, static_cast<int>(std::floor(minY)) - 1,
+                     static_cast<int>(std::ceil(maxX - minX)) + 3,
+                     static_cast<int>(std::ceil(maxY - minY)) + 3) &
+            whole;
+        plane.weight = cv::Mat::zeros(plane.cameraBox.size(), CV_32FC3);
+        planes_.push_back(plane);
+        return static_cast<int>(planes_.size()) - 1;
+    };
+    if (props_.card) {
+        const Eigen::Isometry3d& pose = props_.card->faceToTable;
+        const double x0 = (kCardLengthMm - kStripeLengthMm) / 2.0;
+        faces.push_back({FaceRect::of(pose, 0, kCardLengthMm, 0, kCardWidthMm),
+                         addPlane(pose, cardCorners(*props_.card)), kCardAlbedo,
+                         FaceRect::of(pose, x0, x0 + kStripeLengthMm, kStripeOffsetMm,
+                                      kStripeOffsetMm + kStripeWidthMm)});
+    }
+    if (props_.board) {
+        const BoardProp& board = *props_.board;
+        const double hx = board.sizeMm.width / 2.0, hy = board.sizeMm.height / 2.0;
+        faces.push_back({FaceRect::of(board.faceToTable, -hx, hx, -hy, hy),
+                         addPlane(board.faceToTable, boardCorners(board)), kBoardAlbedo, std::nullopt});
+        // The board's outline as the projector sees it: the light it takes from what lies behind it.
+        boardShadow_.create(calibration_.projectorSize, CV_8UC1);
+        boardShadow_.setTo(0);
+        constexpr int kShift = 8;
+        std::vector<cv::Point> outline;
+        for (const Eigen::Vector3d& corner : boardCorners(board)) {
+            const Eigen::Vector3d q = calibration_.projectorMatrix * (calibration_.tableToProjector * corner);
+            outline.emplace_back(static_cast<int>(std::lround(q.x() / q.z() * (1 << kShift))),
+                                 static_cast<int>(std::lround(q.y() / q.z() * (1 << kShift))));
+        }
+        cv::fillConvexPoly(boardShadow_, outline, cv::Scalar(255), cv::LINE_AA, kShift);
+        boardShadow_.convertTo(boardShadow_, CV_32F, 1.0 / 255.0);
+        blurIfNeeded(boardShadow_, boardShadow_, parameters_.projectorDefocusPx);
+        // A card not lying on the board is in its shadow where the board is nearer to the projector.
+        if (props_.card) {
+            const Eigen::Vector3d centre =
+                props_.card->faceToTable * Eigen::Vector3d(kCardLengthMm / 2, kCardWidthMm / 2, 0);
+            const double t = faces.back().rect.planeHit(projectorCentre_, centre - projectorCentre_);
+            planes_[faces.front().plane].shadowedByBoard = t > 0.0 && t < 1.0;
+        }
+    }
+    if (faces.empty()) {
+        cv::Mat ambientTerm = sceneAlbedo_.mul(cv::Scalar(ambientBgr_.x(), ambientBgr_.y(), ambientBgr_.z()));
+        ambientTerm_ = ambientTerm;
+        blurIfNeeded(ambientTerm_, ambientBlurred_, parameters_.cameraDefocusPx);
+        ++contentVersion_;
+        return;
+    }
+
+    cv::Rect region;
+    for (size_t k = 1; k < planes_.size(); ++k)
+        region |= planes_[k].cameraBox;
+    // Where each sample ray lands: the nearest face it hits inside its rectangle, else the table.
+    struct Hit {
+        int plane;
+        int material;  // 0 table, 1 face, 2 stripe
+        Eigen::Vector3f albedo;
+        float incidence;
+        float height;
+    };
+    const auto cast = [&](double x, double y, const cv::Vec3f& tableAlbedo) {
+        const Eigen::Vector3d direction = cameraPixelToRay_ * Eigen::Vector3d(x, y, 1.0);
+        double nearest = std::numeric_limits<double>::infinity();
+        const Face* seen = nullptr;
+        for (const Face& face : faces) {
+            const double t = face.rect.planeHit(cameraCentre_, direction);
+            if (t > 0.0 && t < nearest && face.rect.contains(cameraCentre_ + t * direction))
+                nearest = t, seen = &face;
+        }
+        Hit hit;
+        Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+        if (seen) {
+            const Eigen::Vector3d point = cameraCentre_ + nearest * direction;
+            hit.plane = seen->plane;
+            const bool stripe = seen->stripe && seen->stripe->contains(point);
+            hit.material = stripe ? 2 : 1;
+            hit.albedo = stripe ? kStripeAlbedo : seen->albedo;
+            normal = seen->rect.normal;
+            hit.height = static_cast<float>(point.z());
+        } else {
+            nearest = -cameraCentre_.z() / direction.z();
+            hit.plane = 0;
+            hit.material = 0;
+            hit.albedo = Eigen::Vector3f(tableAlbedo[0], tableAlbedo[1], tableAlbedo[2]);
+            hit.height = 0.0f;
+        }
+        const Eigen::Vector3d point = cameraCentre_ + nearest * direction;
+        const Eigen::Vector3d toProjector = projectorCentre_ - point;
+        const double r2 = toProjector.squaredNorm();
+        const double cosine = std::max(0.0, normal.dot(toProjector) / std::sqrt(r2));
+        hit.incidence = static_cast<float>(referenceDistance2_ / r2 * cosine / referenceCosine_);
+        return hit;
+    };
+    const int coarse = fine ? parameters_.pixelSamples : 1;
+    constexpr int kEdgeSamples = 8;  // per side, where a pixel sees several surfaces or materials
+    std::vector<Hit> hits;
+    for (int y = region.y; y < region.y + region.height; ++y)
+        for (int x = region.x; x < region.x + region.width; ++x) {
+            const cv::Vec3f tableAlbedo = albedo_.at<cv::Vec3f>(y, x);
+            const auto sampleGrid = [&](int n) {
+                hits.clear();
+                for (int j = 0; j < n; ++j)
+                    for (int i = 0; i < n; ++i)
+                        hits.push_back(cast(x + (i + 0.5) / n - 0.5, y + (j + 0.5) / n - 0.5, tableAlbedo));
+            };
+            sampleGrid(coarse);
+            const auto differs = [&](const Hit& h) {
+                return h.plane != hits.front().plane || h.material != hits.front().material;
+            };
+            if (fine && std::any_of(hits.begin(), hits.end(), differs))
+                sampleGrid(kEdgeSamples);
+            if (hits.front().plane == 0 && !std::any_of(hits.begin(), hits.end(), differs))
+                continue;  // the bare table, as precomputed
+            std::array<float, 8> coverage{};
+            Eigen::Vector3f albedo = Eigen::Vector3f::Zero();
+            const float share = 1.0f / static_cast<float>(hits.size());
+            cv::Vec3f& tableWeight = planes_[0].weight.at<cv::Vec3f>(y, x);
+            tableWeight = cv::Vec3f::all(0.0f);
+            for (const Hit& h : hits) {
+                const Eigen::Vector3f w = h.albedo * (h.incidence * share);
+                ScenePlane& plane = planes_[h.plane];
+                cv::Vec3f& weight = plane.weight.at<cv::Vec3f>(y - plane.cameraBox.y, x - plane.cameraBox.x);
+                weight += cv::Vec3f(w.x(), w.y(), w.z());
+                albedo += h.albedo * share;
+                coverage[h.plane] += share;
+            }
+            sceneAlbedo_.at<cv::Vec3f>(y, x) = cv::Vec3f(albedo.x(), albedo.y(), albedo.z());
+            planeLabel_.at<uchar>(y, x) =
+                static_cast<uchar>(std::max_element(coverage.begin(), coverage.end()) - coverage.begin());
+            sceneHeight_.at<float>(y, x) = cast(x, y, tableAlbedo).height;
+        }
+    ambientTerm_ = sceneAlbedo_.mul(cv::Scalar(ambientBgr_.x(), ambientBgr_.y(), ambientBgr_.z()));
+    blurIfNeeded(ambientTerm_, ambientBlurred_, parameters_.cameraDefocusPx);
+    ++contentVersion_;
 }
 
 void Renderer::castShadows(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box) {
@@ -322,31 +625,48 @@ void Renderer::castShadows(const std::vector<PreparedCapsule>& capsules, const c
 cv::Rect Renderer::shadowOnTable(const cv::Rect& projectorBox) const {
     if (projectorBox.area() == 0)
         return {};
-    double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
-    for (int corner = 0; corner < 4; ++corner) {
-        const Eigen::Vector2d panel(projectorBox.x + ((corner & 1) ? projectorBox.width : 0),
-                                    projectorBox.y + ((corner & 2) ? projectorBox.height : 0));
-        const Eigen::Vector2d camera = core::applyHomography(projectorToCamera_, panel);
-        minX = std::min(minX, camera.x()), maxX = std::max(maxX, camera.x());
-        minY = std::min(minY, camera.y()), maxY = std::max(maxY, camera.y());
+    cv::Rect onPlanes;
+    for (const ScenePlane& plane : planes_) {
+        const Eigen::Matrix3d projectorToCamera = plane.cameraToProjector.inverse();
+        double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+        for (int corner = 0; corner < 4; ++corner) {
+            const Eigen::Vector2d panel(projectorBox.x + ((corner & 1) ? projectorBox.width : 0),
+                                        projectorBox.y + ((corner & 2) ? projectorBox.height : 0));
+            const Eigen::Vector2d camera = core::applyHomography(projectorToCamera, panel);
+            minX = std::min(minX, camera.x()), maxX = std::max(maxX, camera.x());
+            minY = std::min(minY, camera.y()), maxY = std::max(maxY, camera.y());
+        }
+        const cv::Rect box(static_cast<int>(minX) - 2, static_cast<int>(minY) - 2,
+                           static_cast<int>(maxX - minX) + 5, static_cast<int>(maxY - minY) + 5);
+        onPlanes |= box & plane.cameraBox;
     }
-    return cv::Rect(static_cast<int>(minX) - 2, static_cast<int>(minY) - 2, static_cast<int>(maxX - minX) + 5,
-                    static_cast<int>(maxY - minY) + 5) &
-           cv::Rect(0, 0, calibration_.cameraSize.width, calibration_.cameraSize.height);
+    return onPlanes;
 }
 
 void Renderer::shadeTable(const cv::Rect& box, const cv::Mat& projected) {
     if (box.area() == 0 || shadowBox_.area() == 0)
         return;
-    // The shadow mask seen through the table plane: camera pixel (x, y) of `box` -> panel pixel of
-    // shadowBox_.
+    // The shadow mask seen through each plane: camera pixel (x, y) of `box` -> panel pixel of shadowBox_;
+    // each pixel takes it through the plane it mostly sees.
     Eigen::Matrix3d toPanel = Eigen::Matrix3d::Identity(), fromCamera = Eigen::Matrix3d::Identity();
     toPanel(0, 2) = -shadowBox_.x, toPanel(1, 2) = -shadowBox_.y;
     fromCamera(0, 2) = box.x, fromCamera(1, 2) = box.y;
     cv::Mat blocked = blockedOnTable_(box);
-    cv::warpPerspective(shadowMask_(shadowBox_), blocked, toCv(toPanel * cameraToProjector_ * fromCamera),
-                        box.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
-                        cv::Scalar(0));
+    cv::warpPerspective(shadowMask_(shadowBox_), blocked,
+                        toCv(toPanel * planes_[0].cameraToProjector * fromCamera), box.size(),
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+    for (size_t k = 1; k < planes_.size(); ++k) {
+        const cv::Rect part = box & planes_[k].cameraBox;
+        if (part.area() == 0)
+            continue;
+        Eigen::Matrix3d fromPart = Eigen::Matrix3d::Identity();
+        fromPart(0, 2) = part.x, fromPart(1, 2) = part.y;
+        cv::Mat onPlane;
+        cv::warpPerspective(shadowMask_(shadowBox_), onPlane,
+                            toCv(toPanel * planes_[k].cameraToProjector * fromPart), part.size(),
+                            cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar(0));
+        onPlane.copyTo(blockedOnTable_(part), planeLabel_(part) == static_cast<int>(k));
+    }
     for (int y = 0; y < box.height; ++y) {
         const float* fraction = blocked.ptr<float>(y);
         float* out = radiance_.ptr<float>(box.y + y) + 3 * box.x;
@@ -511,14 +831,16 @@ void Renderer::prepare(const std::vector<HandPose>& hands, std::vector<PreparedC
 void Renderer::render(const std::vector<std::vector<HandPose>>& exposure, core::Polarity polarity,
                       double ambientLux, double exposureMs, std::uint64_t noiseSeed, cv::Mat& image,
                       FrameTruth& truth) {
-    CV_Assert(!projected_[0].empty() && exposure.size() % 2 == 1);
+    CV_Assert(!panelLight_[0].empty() && exposure.size() % 2 == 1);
     const int polarityIndex = polarity == core::Polarity::Positive ? 0 : 1;
+    if (!projectedValid_[polarityIndex])
+        projectLight(polarityIndex);
     const cv::Size cameraSize = calibration_.cameraSize;
     const cv::Rect whole(0, 0, cameraSize.width, cameraSize.height);
     truth.handMask.create(cameraSize, CV_8UC1);
     truth.handMask.setTo(0);
-    truth.visibleHeightMm.create(cameraSize, CV_32FC1);
-    truth.visibleHeightMm.setTo(0.0f);
+    sceneHeight_.copyTo(truth.visibleHeightMm);
+    truth.props = props_;
     truth.fingertips.clear();
     truth.ambientLux = ambientLux;
     truth.exposureMs = exposureMs;

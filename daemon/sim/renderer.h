@@ -10,6 +10,7 @@
 #include "core/frame.h"
 #include "sim/camera_sensor.h"
 #include "sim/hand.h"
+#include "sim/props.h"
 #include "sim/sim_parameters.h"
 #include "sim/surface.h"
 
@@ -35,6 +36,7 @@ struct FrameTruth {
     cv::Mat visibleHeightMm;  // CV_32FC1, camera size: height above the table of what each pixel sees
     double ambientLux = 0.0;
     double exposureMs = 0.0;
+    Props props;  // the calibration props at mid-exposure
 };
 
 // Touch tolerance of the ground truth: a pad closer to the table than this counts as touching (skin deforms
@@ -50,8 +52,20 @@ public:
     // pattern: CV_8UC1, projector size, 0/1.
     Renderer(const SimParameters& parameters, const core::Calibration& calibration, const cv::Mat& pattern);
 
-    // The display image (BGR 8-bit, display size): recomputes the light of both projected images.
+    // The display image (BGR 8-bit, display size): recomputes the light of both projected images, unless a
+    // projector image is shown instead.
     void setContent(const cv::Mat& displayContent);
+
+    // From the next frame on the projector shows `projectorImage` (8-bit gray or BGR, projector size, panel
+    // pixels: not warped through the display's keystone) instead of the content, the code embedded in it as
+    // always. An empty image returns to the content. Throws std::invalid_argument for another size or type.
+    void setProjectorImage(const cv::Mat& projectorImage);
+
+    // The calibration props in the scene. When they differ from the last ones, what each camera pixel sees of
+    // table and props is ray cast again: with `fine`, n x n samples per pixel (pixel_samples) and 8 x 8 where
+    // a pixel sees more than one surface or material; otherwise one sample per pixel, for props in motion
+    // (whose motion blurs more than that loses), and the projected light of only the polarity rendered.
+    void setProps(const Props& props, bool fine = true);
 
     // Renders the camera frame showing I (Positive) or I' (Negative). `exposure` holds the hands at an odd
     // number of instants spread evenly over the exposure; the image averages them (motion blur) and the truth
@@ -62,8 +76,9 @@ public:
                 FrameTruth& truth);
 
     // Exposure that brings white content on the table (projector white plus `ambientLux`) to the metering
-    // level at the image centre, bounded by the longest allowed exposure.
-    double meterExposureMs(double ambientLux) const;
+    // level at the image centre, and keeps it there on the brightest face of `props` (at its centre), bounded
+    // by the longest allowed exposure.
+    double meterExposureMs(double ambientLux, const std::vector<Props>& props = {}) const;
 
 private:
     // A hand capsule ready for ray casting from both devices, with its image regions.
@@ -84,6 +99,21 @@ private:
     // Ray casts the hands into radiance_; records mask and visible heights into `truth` when given.
     void castHands(const std::vector<PreparedCapsule>& capsules, const cv::Rect& box, int polarityIndex,
                    double ambientLux, FrameTruth* truth);
+    // A flat surface of the static scene: the table or a prop's face.
+    struct ScenePlane {
+        Eigen::Matrix3d cameraToProjector;  // camera pixels -> projector pixels through the plane
+        cv::Rect cameraBox;                 // camera region where it can be seen
+        cv::Mat weight;  // CV_32FC3, cameraBox size: albedo x projector incidence, integrated over the pixel
+                         // (0 where the plane is hidden)
+        bool shadowedByBoard = false;  // the board is between the projector and this plane
+    };
+
+    // Ray casts the static scene (table and props) for every camera pixel the props can change.
+    void buildScene(bool fine);
+    // The light of a projector image (gray or BGR 8-bit, projector size) for both polarities, code embedded.
+    void showPanelImage(const cv::Mat& panelImage);
+    // The static scene's radiance from the projector for one polarity, camera size.
+    void projectLight(int polarityIndex);
     void prepare(const std::vector<HandPose>& hands, std::vector<PreparedCapsule>& capsules,
                  cv::Rect& cameraBox, cv::Rect& projectorBox) const;
     void shadeHit(const PreparedCapsule& capsule, const Eigen::Vector3f& direction, float t,
@@ -99,7 +129,6 @@ private:
     Eigen::Matrix3f projectorProjection_;                     // K_p R_p
     Eigen::Vector3f projectorTranslation_;                    // K_p t_p
     Eigen::Matrix3d cameraToProjector_;                       // table-plane homography
-    Eigen::Matrix3d projectorToCamera_;
     double referenceDistance2_ = 1.0;  // squared projector distance of the display centre
     double referenceCosine_ = 1.0;     // incidence cosine there
     // Static images.
@@ -115,6 +144,19 @@ private:
     cv::Mat projected_[2];
     cv::Mat projectedBlurred_[2];
     cv::Mat skinLight_[2];
+    cv::Mat panelLight_[2];  // CV_32FC3, projector size: light of each panel pixel through the defocus
+    bool projectedValid_[2] = {false, false};
+    cv::Mat panelContent_;    // CV_8UC3, projector size: the content warped onto the panel
+    cv::Mat projectorImage_;  // CV_8UC3, projector size: shown instead of the content when not empty
+    // The static scene: table and props.
+    Props props_;
+    bool propsFine_ = true;
+    cv::Mat tableWeight_;             // CV_32FC3, camera size: table albedo x incidence
+    std::vector<ScenePlane> planes_;  // the table first
+    cv::Mat sceneAlbedo_;  // CV_32FC3, camera size: reflectance of what each pixel sees, integrated
+    cv::Mat sceneHeight_;  // CV_32FC1, camera size: height above the table of what the central ray hits
+    cv::Mat planeLabel_;   // CV_8UC1, camera size: the plane most of each pixel sees (index into planes_)
+    cv::Mat boardShadow_;  // CV_32FC1, projector size: fraction of each panel pixel's light the board takes
     // Per-frame buffers.
     cv::Mat shadowDepth_;  // CV_32FC1, projector size: depth of the nearest hand along each projector ray
     cv::Mat shadowMask_;   // CV_32FC1, projector size: fraction of each panel pixel's light the hands block

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/geometry.h"
+#include "sim/calibration_scenarios.h"
 
 namespace everytouch::sim {
 
@@ -551,8 +552,8 @@ private:
 }  // namespace
 
 const std::vector<std::string>& scenarioNames() {
-    static const std::vector<std::string> names{"grid35", "drag", "multitouch", "hover",
-                                                "palm",   "idle", "demo"};
+    static const std::vector<std::string> names{"grid35", "drag", "multitouch",  "hover",           "palm",
+                                                "idle",   "demo", "table-setup", "pair-calibration"};
     return names;
 }
 
@@ -571,6 +572,10 @@ std::unique_ptr<Scenario> makeScenario(std::string_view name, const ScenarioCont
         return std::make_unique<IdleScenario>(3);
     if (name == "demo")
         return std::make_unique<DemoScenario>(context);
+    if (name == "table-setup")
+        return std::make_unique<TableSetupScenario>(context);
+    if (name == "pair-calibration")
+        return std::make_unique<PairCalibrationScenario>(context);
     std::string known;
     for (const std::string& scenario : scenarioNames())
         known += (known.empty() ? "" : ", ") + scenario;

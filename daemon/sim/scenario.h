@@ -9,6 +9,7 @@
 #include "core/calibration.h"
 #include "sim/content.h"
 #include "sim/hand.h"
+#include "sim/props.h"
 
 namespace everytouch::sim {
 
@@ -17,6 +18,7 @@ struct SceneState {
     std::vector<HandPose> hands;
     ContentKind content = ContentKind::White;  // what the desktop shows ...
     int contentVariant = 0;                    // ... and which random layout of it
+    Props props;                               // calibration props: a card, a board
 };
 
 // A scripted session: hands moving over the table and the content shown, as a pure function of time. Every
@@ -27,6 +29,8 @@ public:
     virtual SceneState at(double seconds) const = 0;
     // Length of one cycle, seconds.
     virtual double cycleSeconds() const = 0;
+    // Every arrangement of props the scenario holds still (the exposure is metered for the brightest).
+    virtual std::vector<Props> stillProps() const { return {}; }
 };
 
 struct ScenarioContext {
@@ -35,7 +39,7 @@ struct ScenarioContext {
     double handScale = 1.0;
 };
 
-// grid35, drag, multitouch, hover, palm, idle, demo.
+// grid35, drag, multitouch, hover, palm, idle, demo, table-setup, pair-calibration.
 const std::vector<std::string>& scenarioNames();
 
 // Throws std::invalid_argument naming the known scenarios when `name` is not one of them.

@@ -60,8 +60,9 @@ Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, co
                 "content: \"" + parameters_.content +
                 "\" is not a procedural kind (grid35, shapes, photo, ui, text, white, gray)");
     }
-    exposureMs_ =
-        parameters_.exposureMs ? *parameters_.exposureMs : renderer_->meterExposureMs(ambientLux(0.0));
+    exposureMs_ = parameters_.exposureMs
+                      ? *parameters_.exposureMs
+                      : renderer_->meterExposureMs(ambientLux(0.0), scenario_->stillProps());
 }
 
 std::uint64_t Simulator::firstFrame() const {
@@ -121,6 +122,10 @@ void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& trut
     // one per camera pixel they travel, and the image averages them.
     const SceneState middle = scenario_->at(start + exposure / 2.0);
     showContent(middle);
+    // Props in motion are cast with one sample per pixel at mid-exposure; still ones in full.
+    const bool still =
+        middle.props == scenario_->at(start).props && middle.props == scenario_->at(start + exposure).props;
+    renderer_->setProps(middle.props, still);
     int instants = 1;
     if (parameters_.motionSamples > 1 && !middle.hands.empty()) {
         const double pixels = 2.0 * travelMm(middle, scenario_->at(start + exposure)) / mmPerCameraPixel_;

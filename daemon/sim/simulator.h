@@ -46,6 +46,12 @@ public:
     // Room light on the table at `seconds`.
     double ambientLux(double seconds) const;
 
+    // From the next rendered frame on the projector shows `projectorImage` (8-bit gray or BGR, exactly the
+    // projector's size, panel pixels, not warped through display_to_projector) instead of the content; the
+    // code stays embedded (I = O + P, I' = O - P). An empty image returns to the content. Throws
+    // std::invalid_argument for another size or type.
+    void projectImage(const cv::Mat& projectorImage) { renderer_->setProjectorImage(projectorImage); }
+
     // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`. The frame's
     // timestamp is the start of its exposure; the truth describes the scene at mid-exposure.
     void render(std::uint64_t index, core::Frame& frame, FrameTruth& truth);
