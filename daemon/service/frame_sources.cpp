@@ -2,6 +2,7 @@
 
 #include "io/input_error.h"
 #include "io/replay_source.h"
+#include "io/sim_projector.h"
 #include "io/sim_source.h"
 
 namespace everytouch::service {
@@ -12,9 +13,12 @@ OpenedRig openRig(const io::RigSpec& spec, bool fast) {
         case io::RigSpec::Kind::Replay:
             rig.source = std::make_unique<io::ReplaySource>(spec.target, !fast);
             return rig;
-        case io::RigSpec::Kind::Sim:
-            rig.source = std::make_unique<io::SimSource>(spec, !fast);
+        case io::RigSpec::Kind::Sim: {
+            auto source = std::make_unique<io::SimSource>(spec, !fast);
+            rig.projector = std::make_unique<io::SimProjector>(*source);
+            rig.source = std::move(source);
             return rig;
+        }
         case io::RigSpec::Kind::Aravis:
         case io::RigSpec::Kind::V4l2:
             throw io::InputError("--rig " + spec.toString(), "",

@@ -16,11 +16,14 @@
 #include <gtest/gtest.h>
 
 #include "core/geometry.h"
+#include "core/projector_chessboard.h"
 #include "io/calibration_file.h"
 #include "io/handles.h"
 #include "io/recording.h"
 #include "service/bus_names.h"
 #include "service/table_set_up_step.h"
+#include "sim/rig_geometry.h"
+#include "sim/sim_parameters.h"
 #include "support/coded_recording.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
@@ -172,14 +175,17 @@ protected:
     void startDaemon(const std::vector<std::string>& extra = {},
                      const std::vector<std::pair<std::string, std::string>>& environment = {},
                      const std::filesystem::path& recording = SharedRecording::path()) {
+        startDaemonOn("replay:" + recording.string(), extra, environment);
+    }
+
+    void startDaemonOn(const std::string& rig, const std::vector<std::string>& extra = {},
+                       const std::vector<std::pair<std::string, std::string>>& environment = {}) {
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
         std::vector<std::pair<std::string, std::string>> variables = {
             {"NOTIFY_SOCKET", notify_->path().string()}};
         variables.insert(variables.end(), environment.begin(), environment.end());
         daemon_ = std::make_unique<test::BackgroundProcess>(
-            concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig",
-                    "replay:" + recording.string()},
-                   extra),
+            concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig", rig}, extra),
             dir_ / "everytouchd.log", variables);
         ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     }
@@ -423,6 +429,96 @@ TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
     RecordProperty("stored_worst_projector_to_camera_px", std::to_string(movedWorstPx));
     EXPECT_GT(movedWorstPx, 2.0) << "the stored calibration should have been off before";
     EXPECT_FALSE(saved.validate());
+}
+
+// The truth of a simulated rig: its calibration follows from its parameters.
+core::Calibration simulatedRig(const std::string& scenario) {
+    sim::SimParameters parameters;
+    parameters.scenario = scenario;
+    return sim::rigCalibration(parameters);
+}
+
+// Worst distance between the camera pixel -> projector pixel maps of two calibrations on the table, over the
+// camera pixels the projector lights.
+double worstCameraToProjectorPx(const core::Calibration& found, const core::Calibration& truth) {
+    double worstPx = 0;
+    for (double x = 40; x <= 600; x += 40)
+        for (double y = 40; y <= 440; y += 40) {
+            const Eigen::Vector2d camera = core::applyHomography(truth.projectorToCameraHomography(), {x, y});
+            if (camera.x() < 0 || camera.y() < 0 || camera.x() > truth.cameraSize.width - 1 ||
+                camera.y() > truth.cameraSize.height - 1)
+                continue;
+            worstPx = std::max(worstPx, (core::applyHomography(found.cameraToProjectorHomography(), camera) -
+                                         Eigen::Vector2d(x, y))
+                                            .norm());
+        }
+    return worstPx;
+}
+
+// After a calibration the projector shows the content again: no chessboard in what the camera sees.
+void expectProjectorGivenBack(const std::filesystem::path& dir, const core::Calibration& truth) {
+    const test::ProcessResult snapshot =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "texture", (dir / "after.png").string()});
+    ASSERT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    const cv::Mat texture = cv::imread((dir / "after.png").string(), cv::IMREAD_UNCHANGED);
+    EXPECT_FALSE(
+        core::detectProjectedChessboard(texture, service::tableSetUpChessboard(), truth.projectorSize)
+            .success)
+        << "the calibration chessboard is still projected";
+}
+
+TEST_F(ServiceTest, TableCalibrationOnTheSimulatedRigRecoversItsTruthAndGivesTheProjectorBack) {
+    // The table moved since the stored calibration; the projector-camera pair did not.
+    const core::Calibration truth = simulatedRig("table-setup");
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemonOn("sim:table-setup", {"--fast"});
+
+    const auto start = std::chrono::steady_clock::now();
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    RecordProperty("stored_worst_camera_to_projector_px",
+                   std::to_string(worstCameraToProjectorPx(moved, truth)));
+    RecordProperty("seconds", std::to_string(seconds));
+    EXPECT_LT(worstPx, 0.5);
+    EXPECT_GT(worstCameraToProjectorPx(moved, truth), 2.0) << "the stored calibration should have been off";
+    expectProjectorGivenBack(dir_.path(), truth);
+}
+
+TEST_F(ServiceTest, ProjectorCalibrationOnTheSimulatedRigRecoversItsPairAndTable) {
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemonOn("sim:pair-calibration,frame_rate=30", {"--fast"});
+    const auto start = std::chrono::steady_clock::now();
+    const test::ProcessResult tool =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--view-timeout-s", "30"});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    EXPECT_THAT(tool.err, HasSubstr("Pose 1 of 6 taken. Pose 2 of 6: tilt the board another way"));
+    EXPECT_THAT(tool.err, HasSubstr("Pose 5 of 6 taken. Pose 6 of 6"));
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    const core::Calibration truth = simulatedRig("pair-calibration");
+    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    RecordProperty("seconds", std::to_string(seconds));
+    EXPECT_LT(worstPx, 0.5);
+    expectProjectorGivenBack(dir_.path(), truth);
 }
 
 TEST_F(ServiceTest, ASecondCalibrationWhileOneRunsIsBusy) {
