@@ -382,7 +382,7 @@ TEST_F(ServiceTest, AFailedCalibrationKeepsThePreviousOne) {
     EXPECT_EQ(get("Calibrated"), "b true\n");
 }
 
-TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
+TEST_F(ServiceTest, ATableRecordingCalibratesWithoutAProjectorOutputAndSaves) {
     // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
     // degrees under the unchanged projector-camera pair.
     const core::Calibration truth = trueRig();
@@ -519,6 +519,29 @@ TEST_F(ServiceTest, ProjectorCalibrationOnTheSimulatedRigRecoversItsPairAndTable
     RecordProperty("seconds", std::to_string(seconds));
     EXPECT_LT(worstPx, 0.5);
     expectProjectorGivenBack(dir_.path(), truth);
+}
+
+TEST_F(ServiceTest, AFailedProjectorStepSaysWhatItMissedAndGivesTheProjectorBack) {
+    // The card lies on the table and nobody brings a board: pose 1 is taken, pose 2 never comes.
+    startDaemonOn("sim:table-setup", {"--fast"});
+    const test::ProcessResult tool = test::runProcess(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--view-timeout-s", "2", "--no-save"});
+    EXPECT_EQ(tool.exitCode, 1);
+    EXPECT_THAT(tool.err, HasSubstr("Pose 1 of 6 taken. Pose 2 of 6: tilt the board another way"));
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: the projector step failed: no pose 2 of 6 was taken "
+                                    "within 2 s (the scene never held still with something new in view)"));
+    expectProjectorGivenBack(dir_.path(), simulatedRig("table-setup"));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+}
+
+TEST_F(ServiceTest, StoppingTheDaemonMidCalibrationEndsTheJobAndTheTool) {
+    startDaemonOn("sim:table-setup", {"--fast"});
+    test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--no-save"},
+                                 dir_ / "calibrate.log");
+    ASSERT_TRUE(waitForProperty("State", "s \"calibrating\""));
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_EQ(tool.wait(kExitTimeout), 1) << tool.output();
 }
 
 TEST_F(ServiceTest, ASecondCalibrationWhileOneRunsIsBusy) {
