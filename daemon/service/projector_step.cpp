@@ -114,8 +114,9 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context,
                            ")");
     }
 
-    context.progress(viewShare * options.views,
-                     "Estimating the projector-camera pair from " + std::to_string(options.views) + " poses");
+    context.progress(viewShare * options.views, poseLabel(options.views, options.views) +
+                                                    " taken. Estimating the projector-camera pair from " +
+                                                    std::to_string(options.views) + " poses");
     core::PairCalibrationOptions pairOptions;
     pairOptions.cameraSize = cameraSize;
     pairOptions.projectorSize = context.projectorSize;
