@@ -21,7 +21,7 @@ CalibrationStep projectorStep() {
     return {"projector",
             "the one-time calibration of the projector-camera pair from the table and a board in several "
             "tilts",
-            [](const StepContext& context) { return calibrateProjectorCameraPairStep(context); }};
+            calibrateProjectorCameraPairStep};
 }
 
 CalibrationStep tableStep() {

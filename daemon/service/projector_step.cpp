@@ -53,11 +53,7 @@ std::string formatSeconds(double seconds) {
 }  // namespace
 
 EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
-    return calibrateProjectorCameraPairStep(context, PoseCaptureOptions());
-}
-
-EstimateResult calibrateProjectorCameraPairStep(const StepContext& context,
-                                                const PoseCaptureOptions& captureOptions) {
+    const PoseCaptureOptions captureOptions;
     const CalibrationOptions& options = context.options;
     const cv::Size2d cardSizeMm(options.cardWidthMm, options.cardHeightMm);
     cv::Mat board;

@@ -15,8 +15,4 @@ namespace everytouch::service {
 // options.viewTimeoutS of camera time.
 EstimateResult calibrateProjectorCameraPairStep(const StepContext& context);
 
-// The same with explicit capture options (tests use shorter still spells).
-EstimateResult calibrateProjectorCameraPairStep(const StepContext& context,
-                                                const PoseCaptureOptions& capture);
-
 }  // namespace everytouch::service

@@ -101,6 +101,22 @@ PoseCapture captureFor(const PoseCaptureOptions& options = {}) {
                        core::pairOf(truthRig()).camera);
 }
 
+TEST(PoseCaptureOptions, AreRangeChecked) {
+    EXPECT_FALSE(PoseCaptureOptions().validate());
+    PoseCaptureOptions options;
+    options.changeSigmas = 1.0;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("changeSigmas"));
+    options = PoseCaptureOptions();
+    options.stillSeconds = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("stillSeconds"));
+    options = PoseCaptureOptions();
+    options.maxChangedFraction = 1.0;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("maxChangedFraction"));
+    options = PoseCaptureOptions();
+    options.minTiltDeg = 90.0;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("minTiltDeg"));
+}
+
 TEST(NoiseLevels, FollowTheSensorNoiseAndNeverFallBelowRounding) {
     const std::vector<double> levels = noiseLevels(poseImage(0, 1));
     ASSERT_EQ(levels.size(), 256u);
