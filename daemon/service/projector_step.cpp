@@ -6,6 +6,7 @@
 #include "core/pair_calibration.h"
 #include "core/projector_camera_pair.h"
 #include "core/table_setup.h"
+#include "service/pose_capture.h"
 #include "service/table_set_up_step.h"
 
 namespace everytouch::service {

@@ -1,7 +1,6 @@
 #pragma once
 
 #include "service/calibration_job.h"
-#include "service/pose_capture.h"
 
 namespace everytouch::service {
 
