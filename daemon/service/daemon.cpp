@@ -520,8 +520,7 @@ void Daemon::snapshot(sd_bus_message* call, std::string_view what, int fd) {
     if (!kind && snapshotNeedsDetection(what))
         throw BusError(SD_BUS_ERROR_INVALID_ARGS,
                        "Snapshot \"" + std::string(what) +
-                           "\" is not available yet: touch detection is not part of "
-                           "this build");
+                           "\" is not available yet: the hand segmentation is not part of this build");
     if (!kind)
         throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Unknown snapshot \"" + std::string(what) +
                                                       "\"; expected " + kSnapshotKinds + " (later also " +
@@ -561,7 +560,8 @@ void Daemon::completeSnapshot(std::uint64_t id, const core::FramePair& pair) {
     if (it == snapshots_.end())
         return;
     cv::Mat image;
-    renderSnapshot(it->second.kind, pair, image);
+    std::uint64_t contactsVersion = 0;
+    renderSnapshot(it->second.kind, pair, store_->active(), loop_->contacts(contactsVersion), image);
     const int r = writeAllWithin(it->second.fd.get(), encodePng(image), kSnapshotWriteTimeout);
     if (r < 0) {
         failSnapshot(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-r));

@@ -8,8 +8,10 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/code_image.h"
+#include "service/snapshot_overlay.h"
 
 namespace everytouch::service {
 
@@ -20,24 +22,41 @@ std::optional<SnapshotKind> parseSnapshotKind(std::string_view name) {
         return SnapshotKind::Texture;
     if (name == "subtraction")
         return SnapshotKind::Subtraction;
+    if (name == "overlay")
+        return SnapshotKind::Overlay;
     return std::nullopt;
 }
 
 bool snapshotNeedsDetection(std::string_view name) {
-    return name == "mask" || name == "overlay";
+    return name == "mask";
 }
 
-void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
+void renderSnapshot(SnapshotKind kind, const core::FramePair& pair,
+                    const std::optional<core::Calibration>& calibration, const core::Contacts& contacts,
+                    cv::Mat& image) {
     if (kind == SnapshotKind::Camera) {
         pair.latest().image.copyTo(image);
         return;
     }
     cv::Mat subtraction, texture;
     core::computeSubtractionAndTexture(pair, subtraction, texture);
-    if (kind == SnapshotKind::Texture)
-        image = texture;
-    else
-        subtraction.convertTo(image, CV_8U);  // saturates: negative differences become 0
+    switch (kind) {
+        case SnapshotKind::Texture:
+            image = texture;
+            return;
+        case SnapshotKind::Subtraction:
+            subtraction.convertTo(image, CV_8U);  // saturates: negative differences become 0
+            return;
+        case SnapshotKind::Overlay:
+            if (texture.channels() == 1)
+                cv::cvtColor(texture, image, cv::COLOR_GRAY2BGR);
+            else
+                image = texture;
+            drawOverlay(calibration, contacts, image);
+            return;
+        case SnapshotKind::Camera:
+            return;
+    }
 }
 
 std::vector<unsigned char> encodePng(const cv::Mat& image) {

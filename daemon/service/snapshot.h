@@ -7,6 +7,8 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "core/calibration.h"
+#include "core/contact.h"
 #include "core/frame.h"
 
 namespace everytouch::service {
@@ -16,17 +18,21 @@ enum class SnapshotKind {
     Camera,       // the newer camera frame of a pair, as the camera gives it
     Texture,      // T = (C+ + C-) / 2: the scene without the code
     Subtraction,  // S = max over channels of (C+ - C-), negative differences clipped to 0: the code
+    Overlay,      // the texture in colour with the projected display's outline and the contacts (drawOverlay)
 };
 
-inline constexpr const char* kSnapshotKinds = "camera, texture, subtraction";
-// Kinds that need touch detection, which this build does not have yet.
-inline constexpr const char* kSnapshotKindsNeedingDetection = "mask, overlay";
+inline constexpr const char* kSnapshotKinds = "camera, texture, subtraction, overlay";
+// Kinds that need the hand segmentation, which this build does not have yet.
+inline constexpr const char* kSnapshotKindsNeedingDetection = "mask";
 
 std::optional<SnapshotKind> parseSnapshotKind(std::string_view name);
 bool snapshotNeedsDetection(std::string_view name);
 
-// Renders `kind` of `pair` into `image` (8-bit, the camera's channels; one channel for Subtraction).
-void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image);
+// Renders `kind` of `pair` into `image` (8-bit, the camera's channels; one channel for Subtraction, BGR for
+// Overlay). The overlay draws the calibration's display outline and the contacts.
+void renderSnapshot(SnapshotKind kind, const core::FramePair& pair,
+                    const std::optional<core::Calibration>& calibration, const core::Contacts& contacts,
+                    cv::Mat& image);
 
 // PNG bytes of an 8-bit image.
 std::vector<unsigned char> encodePng(const cv::Mat& image);

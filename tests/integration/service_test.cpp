@@ -7,9 +7,9 @@
 
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <thread>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include <gmock/gmock.h>
@@ -25,6 +25,7 @@
 #include "sim/rig_geometry.h"
 #include "sim/sim_parameters.h"
 #include "support/coded_recording.h"
+#include "support/file_contents.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
 #include "support/process.h"
@@ -67,13 +68,6 @@ std::vector<std::string> property(const std::string& verb, const std::string& na
 
 std::vector<std::string> call(const std::string& method, const std::vector<std::string>& arguments = {}) {
     return concat(busctl({"call", bus::kBusName, bus::kObjectPath, bus::kInterface, method}), arguments);
-}
-
-std::string fileContents(const std::filesystem::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
 }
 
 // A recording long enough for any test (a minute at 10 frames/s), shared by the tests of one process.
@@ -589,13 +583,21 @@ TEST_F(ServiceTest, AnUnprivilegedCallerCanReadButNotChangeAnything) {
 TEST_F(ServiceTest, SnapshotsArePngsOfWhatTheCameraSees) {
     startDaemon();
     const test::CodedImages images = test::codedImages(test::smallRig().calibration.cameraSize, 10);
-    for (const char* what : {"camera", "texture", "subtraction"}) {
+    for (const char* what : {"camera", "texture", "subtraction", "overlay"}) {
         const std::filesystem::path file = dir_ / (std::string(what) + ".png");
         const test::ProcessResult result =
             test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", what, file.string()});
         ASSERT_EQ(result.exitCode, 0) << result.err;
         const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
         ASSERT_EQ(image.size(), test::smallRig().calibration.cameraSize) << what;
+        if (std::string(what) == "overlay") {
+            // The recorded rig is calibrated: the projected display's outline is drawn in green.
+            ASSERT_EQ(image.type(), CV_8UC3);
+            cv::Mat green;
+            cv::inRange(image, cv::Scalar(0, 200, 0), cv::Scalar(60, 255, 60), green);
+            EXPECT_GT(cv::countNonZero(green), image.cols) << "no display outline";
+            continue;
+        }
         ASSERT_EQ(image.type(), CV_8UC1) << what;
         if (std::string(what) == "camera") {
             EXPECT_TRUE(cv::norm(image, images.positive, cv::NORM_INF) == 0.0 ||
@@ -708,7 +710,7 @@ TEST_F(ServiceTest, ReloadRejectsABadConfigurationAndAppliesAGoodOne) {
 
 TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     std::ofstream(dir_ / "calibration.yml") << "%YAML:1.0\n---\nformat: everytouch-calibration\nversion: 7\n";
-    const std::string before = fileContents(dir_ / "calibration.yml");
+    const std::string before = test::fileContents(dir_ / "calibration.yml");
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
     startDaemon();
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
@@ -716,7 +718,7 @@ TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration.yml: version: unsupported version"));
     const test::ProcessResult save = test::runProcess(call("SaveCalibration"));
     EXPECT_THAT(save.err, HasSubstr("There is no calibration to save"));
-    EXPECT_EQ(fileContents(dir_ / "calibration.yml"), before);
+    EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), before);
 }
 
 TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveOne) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "service/config.h"
+#include "support/file_contents.h"
 #include "support/process.h"
 #include "support/temp_dir.h"
 
@@ -15,13 +16,6 @@ namespace everytouch {
 namespace {
 
 using ::testing::HasSubstr;
-
-std::string contents(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
 
 TEST(SystemFiles, TheUnitVerifies) {
     // systemd-analyze exits 0 even on typos; it prints nothing only when everything is understood.
@@ -35,8 +29,8 @@ TEST(SystemFiles, TheUnitStaysHardened) {
     const test::ProcessResult result = test::runProcess(
         {"/usr/bin/systemd-analyze", "security", "--offline=true", "--threshold=30", BUILD_UNIT_FILE});
     EXPECT_EQ(result.exitCode, 0) << "exposure above 3.0:\n" << result.out;
-    EXPECT_THAT(contents(BUILD_UNIT_FILE), HasSubstr("Type=notify"));
-    EXPECT_THAT(contents(BUILD_UNIT_FILE), HasSubstr("ExecStart=" EVERYTOUCHD_PATH " --service"));
+    EXPECT_THAT(test::fileContents(BUILD_UNIT_FILE), HasSubstr("Type=notify"));
+    EXPECT_THAT(test::fileContents(BUILD_UNIT_FILE), HasSubstr("ExecStart=" EVERYTOUCHD_PATH " --service"));
 }
 
 // The keys the example shows commented out, as "[Section] Key".
@@ -55,8 +49,8 @@ std::set<std::string> commentedKeys(const std::string& example) {
 }
 
 TEST(SystemFiles, TheExampleConfigurationAndTheManualDocumentEveryKey) {
-    const std::string example = contents(EXAMPLE_CONFIG);
-    const std::string manual = contents(DAEMON_MANUAL);
+    const std::string example = test::fileContents(EXAMPLE_CONFIG);
+    const std::string manual = test::fileContents(DAEMON_MANUAL);
     std::set<std::string> known;
     for (const auto& [section, key] : service::configKeys()) {
         known.insert("[" + section + "] " + key);

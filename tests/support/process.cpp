@@ -8,11 +8,11 @@
 #include <unistd.h>
 
 #include <array>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <system_error>
 #include <thread>
+
+#include "support/file_contents.h"
 
 extern char** environ;
 
@@ -127,10 +127,7 @@ void BackgroundProcess::signal(int number) const {
 }
 
 std::string BackgroundProcess::output() const {
-    std::ifstream in(outputFile_);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
+    return fileContents(outputFile_);
 }
 
 std::optional<int> BackgroundProcess::wait(std::chrono::milliseconds timeout) {

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Runs uinput_device_tests and the daemon on a real Linux kernel: Debian's own kernel package (downloaded with
 # apt-get, extracted, never installed) boots under QEMU (TCG, no KVM needed) into a busybox initramfs with
-# systemd-udevd, the input rules, libinput and evemu. All cases run in one boot. Exit 0 iff the guest
-# reports "VMTEST RESULT: PASS".
+# systemd-udevd, the input rules, libinput, evemu and dbus-daemon. All cases run in one boot. Exit 0 iff the
+# guest reports "VMTEST RESULT: PASS".
 #
 # usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR
 # environment: EVERYTOUCH_VM_CACHE  where the kernel is kept between runs (default: DIR/cache)
@@ -33,6 +33,7 @@ need xz xz-utils
 need libinput libinput-tools
 need evemu-record evemu-tools
 need udevadm udev
+need dbus-daemon dbus
 need apt-get apt
 busybox=$(command -v busybox)
 ldd "$busybox" >/dev/null 2>&1 && fail "$busybox is not static: install busybox-static"
@@ -112,7 +113,7 @@ copy_program() {
     copy_libraries "$1"
 }
 for program in /usr/bin/libinput /usr/libexec/libinput/libinput-{list-devices,debug-events} \
-    /usr/bin/evemu-record /usr/bin/udevadm \
+    /usr/bin/evemu-record /usr/bin/udevadm /usr/bin/dbus-daemon \
     /usr/lib/udev/libinput-device-group /usr/lib/udev/libinput-fuzz-extract /usr/lib/udev/libinput-fuzz-to-zero; do
     copy_program "$program"
 done

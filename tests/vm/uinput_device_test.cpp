@@ -5,10 +5,10 @@
 #include <linux/input.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <systemd/sd-bus.h>
 
 #include <csignal>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -20,6 +20,9 @@
 #include "io/handles.h"
 #include "io/recording.h"
 #include "io/uinput_sink.h"
+#include "service/bus_names.h"
+#include "support/file_contents.h"
+#include "support/private_bus.h"
 #include "support/process.h"
 #include "support/temp_dir.h"
 #include "support/test_rig.h"
@@ -47,13 +50,6 @@ constexpr auto kPatience = 30s;
                    "EVERYTOUCH_UINPUT_TESTS=1 to run them";                                            \
     } while (false)
 
-std::string readFile(const std::filesystem::path& path) {
-    std::ifstream stream(path);
-    std::stringstream text;
-    text << stream.rdbuf();
-    return text.str();
-}
-
 template <typename Condition>
 bool waitFor(Condition condition, std::chrono::milliseconds timeout = kPatience) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
@@ -79,7 +75,7 @@ std::string udevProperties(const std::string& devnode) {
     const std::filesystem::path entry = udevDatabaseEntry(devnode);
     if (entry.empty() || !waitFor([&] { return std::filesystem::exists(entry); }))
         return {};
-    return readFile(entry);
+    return test::fileContents(entry);
 }
 
 // Waits until udev has processed the removal of a device, whose event node a new device may get next.
@@ -247,8 +243,8 @@ protected:
         std::this_thread::sleep_for(300ms);
         libinput_->signal(SIGINT);
         EXPECT_TRUE(libinput_->wait(kPatience)) << "libinput debug-events did not stop";
-        libinputOutput_ = readFile(dir_ / "libinput.txt");
-        evemuOutput_ = readFile(dir_ / "evemu.txt");
+        libinputOutput_ = test::fileContents(dir_ / "libinput.txt");
+        evemuOutput_ = test::fileContents(dir_ / "evemu.txt");
         EXPECT_TRUE(udevForgot(udevEntry_));
     }
 
@@ -413,7 +409,7 @@ TEST(UinputSink, ANewDisplaySizeRecreatesTheDeviceAfterLiftingContacts) {
     ASSERT_TRUE(sink.applyCalibration(calibration));
     EXPECT_NE(sink.devnode(), first);
     EXPECT_TRUE(evemu.wait(kPatience)) << "evemu-record still reads the old device";
-    const std::string oldEvents = describe(evemuEvents(readFile(dir / "evemu.txt")));
+    const std::string oldEvents = describe(evemuEvents(test::fileContents(dir / "evemu.txt")));
     EXPECT_THAT(oldEvents, ::testing::EndsWith("ABS_MT_TRACKING_ID -1\nBTN_TOUCH 0\nBTN_TOOL_FINGER 0\n"
                                                "MSC_TIMESTAMP 0\nSYN_REPORT 0\n"));
     EXPECT_TRUE(udevForgot(firstEntry));
@@ -430,9 +426,26 @@ TEST(UinputSink, ANewDisplaySizeRecreatesTheDeviceAfterLiftingContacts) {
     EXPECT_TRUE(udevForgot(secondEntry));
 }
 
+// The DevicePath property of the daemon on the system bus; empty when it cannot be read.
+std::string busDevicePath() {
+    sd_bus* raw = nullptr;
+    if (sd_bus_open_system(&raw) < 0)
+        return {};
+    const io::Bus bus(raw);
+    sd_bus_error error = SD_BUS_ERROR_NULL;
+    char* value = nullptr;
+    const int r = sd_bus_get_property_string(bus.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                             "DevicePath", &error, &value);
+    sd_bus_error_free(&error);
+    if (r < 0)
+        return {};
+    const std::unique_ptr<char, decltype(&std::free)> owned(value, &std::free);
+    return value;
+}
+
 // The daemon on a recording of the paper rig, with --output uinput: the touchscreen it creates has the size
-// of the recorded rig's projected display and goes away with the daemon. (Contacts follow once detection is
-// part of the pipeline.)
+// of the recorded rig's projected display, its node is the daemon's DevicePath on the bus, and it goes away
+// with the daemon. (Contacts follow once detection is part of the pipeline.)
 TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
     SKIP_WITHOUT_UINPUT();
     test::TempDir dir;
@@ -448,6 +461,8 @@ TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
             writer.addFrame(frame);
         }
     }
+    // The daemon's own checks are tested elsewhere; here any caller may read.
+    const test::PrivateBus bus("", true);
     const char* daemonPath = std::getenv("EVERYTOUCHD");
     test::BackgroundProcess daemon({daemonPath ? daemonPath : EVERYTOUCHD_PATH, "--rig",
                                     "replay:" + (dir / "recording").string(), "--output", "uinput"},
@@ -456,11 +471,14 @@ TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
     std::string log;
     const std::regex announced("virtual touchscreen (/dev/input/event[0-9]+)");
     ASSERT_TRUE(waitFor([&] {
-        log = readFile(dir / "daemon.log");
+        log = test::fileContents(dir / "daemon.log");
         return std::regex_search(log, match, announced);
     })) << log;
     const std::string devnode = match[1];
     ASSERT_THAT(udevProperties(devnode), HasSubstr("E:ID_INPUT_TOUCHSCREEN=1"));
+    std::string published;
+    EXPECT_TRUE(waitFor([&] { return (published = busDevicePath()) == devnode; }))
+        << "DevicePath is \"" << published << "\", the device " << devnode;
 
     const test::ProcessResult listing = test::runProcess({"/usr/bin/libinput", "list-devices"});
     const std::string block = libinputDeviceBlock(listing.out, devnode);
@@ -473,10 +491,10 @@ TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
     EXPECT_NEAR(reported.height, projected.height, 0.02 * projected.height) << block;
 
     daemon.signal(SIGTERM);
-    EXPECT_EQ(daemon.wait(kPatience), 0) << readFile(dir / "daemon.log");
+    EXPECT_EQ(daemon.wait(kPatience), 0) << test::fileContents(dir / "daemon.log");
     EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); }))
         << "the touchscreen outlived the daemon";
-    std::cout << "everytouchd log:\n" << readFile(dir / "daemon.log");
+    std::cout << "everytouchd log:\n" << test::fileContents(dir / "daemon.log");
 }
 
 }  // namespace

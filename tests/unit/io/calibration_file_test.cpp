@@ -2,12 +2,12 @@
 
 #include <fstream>
 #include <regex>
-#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "io/input_error.h"
+#include "support/file_contents.h"
 #include "support/temp_dir.h"
 #include "support/test_rig.h"
 
@@ -17,13 +17,6 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-std::string readText(const std::filesystem::path& path) {
-    std::ifstream input(path);
-    std::stringstream text;
-    text << input.rdbuf();
-    return text.str();
-}
-
 void writeText(const std::filesystem::path& path, const std::string& text) {
     std::ofstream(path) << text;
 }
@@ -32,7 +25,7 @@ class CalibrationFileTest : public ::testing::Test {
 protected:
     void SetUp() override {
         writeCalibrationFile(good_, test::paperLikeCalibration());
-        goodText_ = readText(good_);
+        goodText_ = test::fileContents(good_);
     }
 
     // Writes the good file with `pattern` replaced by `replacement` and returns the reader's complaint.
@@ -128,7 +121,7 @@ TEST_F(CalibrationFileTest, FailedWriteLeavesTheOldFileIntact) {
     core::Calibration broken = test::paperLikeCalibration();
     broken.cameraMatrix(1, 1) = 0;
     EXPECT_THROW(writeCalibrationFile(good_, broken), InputError);
-    EXPECT_EQ(readText(good_), goodText_);
+    EXPECT_EQ(test::fileContents(good_), goodText_);
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_.path()), {}), 1)
         << "a temporary file was left";
 }

@@ -2,13 +2,13 @@
 
 #include <fstream>
 #include <regex>
-#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "io/input_error.h"
+#include "support/file_contents.h"
 #include "support/temp_dir.h"
 #include "support/test_rig.h"
 
@@ -17,13 +17,6 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-
-std::string readText(const std::filesystem::path& path) {
-    std::ifstream input(path);
-    std::stringstream text;
-    text << input.rdbuf();
-    return text.str();
-}
 
 void writeText(const std::filesystem::path& path, const std::string& text) {
     std::ofstream(path) << text;
@@ -64,7 +57,7 @@ protected:
 
     // Replaces the first match of `pattern` in the recording's `file`.
     void edit(const std::string& file, const std::string& pattern, const std::string& replacement) {
-        const std::string before = readText(dir_ / file);
+        const std::string before = test::fileContents(dir_ / file);
         const std::string after = std::regex_replace(before, std::regex(pattern), replacement,
                                                      std::regex_constants::format_first_only);
         ASSERT_NE(before, after) << pattern;
@@ -118,7 +111,7 @@ TEST_F(RecordingTest, RejectsMissingFrameFile) {
 }
 
 TEST_F(RecordingTest, RejectsTruncatedFramesLine) {
-    const std::string text = readText(dir_ / "frames.csv");
+    const std::string text = test::fileContents(dir_ / "frames.csv");
     writeText(dir_ / "frames.csv", text.substr(0, text.size() - 4));
     EXPECT_THAT(complaint(), AllOf(HasSubstr("frames.csv"), HasSubstr("line 5")));
 }

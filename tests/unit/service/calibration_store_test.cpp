@@ -1,12 +1,12 @@
 #include "service/calibration_store.h"
 
 #include <fstream>
-#include <sstream>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "io/calibration_file.h"
+#include "support/file_contents.h"
 #include "support/temp_dir.h"
 #include "support/test_rig.h"
 
@@ -14,13 +14,6 @@ namespace everytouch::service {
 namespace {
 
 using ::testing::HasSubstr;
-
-std::string contents(const std::filesystem::path& path) {
-    std::ifstream in(path);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
 
 TEST(CalibrationStore, WithoutAFileTheRigsOwnCalibrationIsActive) {
     CalibrationStore store("", test::paperLikeCalibration());
@@ -61,14 +54,14 @@ TEST(CalibrationStore, ACorruptFileIsReportedAndLeftAlone) {
     test::TempDir dir;
     std::ofstream(dir / "calibration.yml")
         << "%YAML:1.0\n---\nformat: everytouch-calibration\nversion: 1\ncamera_size: [1]\n";
-    const std::string before = contents(dir / "calibration.yml");
+    const std::string before = test::fileContents(dir / "calibration.yml");
     CalibrationStore store(dir / "calibration.yml", test::paperLikeCalibration());
     const std::optional<std::string> problem = store.load();
     ASSERT_TRUE(problem);
     EXPECT_THAT(*problem, HasSubstr("calibration.yml"));
     EXPECT_THAT(*problem, HasSubstr("camera_size"));
     EXPECT_FALSE(store.active());
-    EXPECT_EQ(contents(dir / "calibration.yml"), before);
+    EXPECT_EQ(test::fileContents(dir / "calibration.yml"), before);
 }
 
 }  // namespace

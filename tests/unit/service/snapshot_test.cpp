@@ -5,10 +5,15 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <gtest/gtest.h>
 
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
 #include "support/coded_recording.h"
+#include "support/test_rig.h"
 
 namespace everytouch::service {
 namespace {
@@ -27,9 +32,10 @@ core::FramePair pairOf(const cv::Mat& positive, const cv::Mat& negative) {
 
 TEST(Snapshot, NamesAreParsed) {
     EXPECT_EQ(parseSnapshotKind("texture"), SnapshotKind::Texture);
+    EXPECT_EQ(parseSnapshotKind("overlay"), SnapshotKind::Overlay);
     EXPECT_FALSE(parseSnapshotKind("mask"));
     EXPECT_TRUE(snapshotNeedsDetection("mask"));
-    EXPECT_TRUE(snapshotNeedsDetection("overlay"));
+    EXPECT_FALSE(snapshotNeedsDetection("overlay"));
     EXPECT_FALSE(snapshotNeedsDetection("photo"));
 }
 
@@ -37,9 +43,9 @@ TEST(Snapshot, TextureAndSubtractionSeparateSceneAndCode) {
     const test::CodedImages images = test::codedImages({64, 48}, 10);
     const core::FramePair pair = pairOf(images.positive, images.negative);
     cv::Mat camera, texture, subtraction;
-    renderSnapshot(SnapshotKind::Camera, pair, camera);
-    renderSnapshot(SnapshotKind::Texture, pair, texture);
-    renderSnapshot(SnapshotKind::Subtraction, pair, subtraction);
+    renderSnapshot(SnapshotKind::Camera, pair, std::nullopt, {}, camera);
+    renderSnapshot(SnapshotKind::Texture, pair, std::nullopt, {}, texture);
+    renderSnapshot(SnapshotKind::Subtraction, pair, std::nullopt, {}, subtraction);
     EXPECT_EQ(cv::norm(camera, images.negative, cv::NORM_INF), 0.0);  // the newer frame
     const cv::Mat table = (images.positive + images.negative) / 2;
     EXPECT_LE(cv::norm(texture, table, cv::NORM_INF), 1.0);
@@ -54,9 +60,69 @@ TEST(Snapshot, SubtractionTakesTheLargestChannelAndClipsNegatives) {
     cv::Mat negative(2, 2, CV_8UC3, cv::Scalar(90, 120, 95));
     positive.at<cv::Vec3b>(1, 1) = {50, 50, 50};
     cv::Mat subtraction;
-    renderSnapshot(SnapshotKind::Subtraction, pairOf(positive, negative), subtraction);
+    renderSnapshot(SnapshotKind::Subtraction, pairOf(positive, negative), std::nullopt, {}, subtraction);
     EXPECT_EQ(subtraction.at<std::uint8_t>(0, 0), 10);
     EXPECT_EQ(subtraction.at<std::uint8_t>(1, 1), 0);
+}
+
+// Where a display pixel appears in the raw camera image, through the plane heightMm above the table.
+cv::Point cameraPixelOf(const core::Calibration& calibration, cv::Point2d display, double heightMm) {
+    const Eigen::Vector2d undistorted = core::applyHomography(
+        calibration.cameraToDisplayHomography(heightMm).inverse(), Eigen::Vector2d(display.x, display.y));
+    const Eigen::Vector2d raw =
+        core::CameraModel{calibration.cameraMatrix, calibration.cameraDistortion}.distortPixel(undistorted);
+    return {cvRound(raw.x()), cvRound(raw.y())};
+}
+
+TEST(Snapshot, OverlayDrawsTheDisplayOutlineAndTheContactsWhereTheCalibrationPutsThem) {
+    core::Calibration calibration = test::paperLikeCalibration();
+    calibration.cameraDistortion << -0.12, 0.08, 0.0, 0.0, 0.0;
+    const cv::Mat gray(calibration.cameraSize, CV_8UC1, cv::Scalar(128));
+    const cv::Point2d centre(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0);
+    core::Contact touching{.id = 1, .x = centre.x, .y = centre.y, .touching = true};
+    core::Contact hovering{.id = 2, .x = centre.x / 2, .y = centre.y, .heightMm = 60.0};
+    cv::Mat overlay;
+    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), calibration, {touching, hovering}, overlay);
+    ASSERT_EQ(overlay.type(), CV_8UC3);
+    ASSERT_EQ(overlay.size(), calibration.cameraSize);
+
+    const auto colourAt = [&](cv::Point at) {
+        EXPECT_TRUE(cv::Rect({}, overlay.size()).contains(at)) << at;
+        return overlay.at<cv::Vec3b>(at);
+    };
+    // The paper's camera sees the bottom of the projected display (the top lies beyond its frame).
+    const double bottom = calibration.displaySize.height;
+    for (const cv::Point2d corner :
+         {cv::Point2d(0, bottom), cv::Point2d(calibration.displaySize.width, bottom)}) {
+        const cv::Point at = cameraPixelOf(calibration, corner, 0.0);
+        EXPECT_GT(colourAt(at)[1], 200) << "no outline at the display corner seen at " << at;
+    }
+    // Halfway along the bottom edge, where the distortion bends the outline away from the corners' chord.
+    const cv::Point middle = cameraPixelOf(calibration, {centre.x, bottom}, 0.0);
+    EXPECT_GT(colourAt(middle)[1], 200) << middle;
+    EXPECT_EQ(colourAt(cameraPixelOf(calibration, centre, 0.0)), cv::Vec3b(0, 0, 255));
+    // The hovering finger's ring is centred where its height puts it, not where the table would.
+    const cv::Point hover = cameraPixelOf(calibration, {hovering.x, hovering.y}, hovering.heightMm);
+    const cv::Point onTable = cameraPixelOf(calibration, {hovering.x, hovering.y}, 0.0);
+    ASSERT_GE(cv::norm(hover - onTable), 4.0) << "the test needs the heights to be told apart";
+    EXPECT_EQ(colourAt(hover), cv::Vec3b(128, 128, 128)) << "a ring, not a dot";
+    const cv::Vec3b yellow(0, 255, 255);
+    const cv::Point offset = onTable - hover;
+    const cv::Point across(-offset.y, offset.x);  // the ring's rim on either side, away from the table point
+    const double scale = 6.0 / cv::norm(across);
+    const cv::Point rim(cvRound(across.x * scale), cvRound(across.y * scale));
+    EXPECT_EQ(colourAt(hover + rim), yellow);
+    EXPECT_EQ(colourAt(hover - rim), yellow);
+}
+
+TEST(Snapshot, OverlaySaysWhenThereIsNoCalibration) {
+    const cv::Mat gray(120, 160, CV_8UC1, cv::Scalar(128));
+    cv::Mat overlay;
+    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), std::nullopt, {}, overlay);
+    ASSERT_EQ(overlay.type(), CV_8UC3);
+    cv::Mat plain;
+    cv::cvtColor(gray, plain, cv::COLOR_GRAY2BGR);
+    EXPECT_GT(cv::norm(overlay, plain, cv::NORM_L1), 0.0) << "nothing written on the image";
 }
 
 TEST(Snapshot, PngGoesThroughAPipe) {

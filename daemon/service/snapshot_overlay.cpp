@@ -1,0 +1,85 @@
+#include "service/snapshot_overlay.h"
+
+#include <cstdio>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace everytouch::service {
+
+namespace {
+
+// Points per display edge: enough for the outline to follow the lens distortion smoothly.
+constexpr int kOutlineSamplesPerEdge = 32;
+const cv::Scalar kOutlineColour(0, 255, 0);
+const cv::Scalar kTouchingColour(0, 0, 255);
+const cv::Scalar kHoveringColour(0, 255, 255);
+const cv::Scalar kPalmColour(160, 160, 160);
+
+// Display pixel -> raw camera pixel, through the plane `heightMm` above the table.
+class DisplayToCamera {
+public:
+    DisplayToCamera(const core::Calibration& calibration, double heightMm)
+        : toUndistorted_(calibration.cameraToDisplayHomography(heightMm).inverse()),
+          camera_{calibration.cameraMatrix, calibration.cameraDistortion} {}
+
+    cv::Point operator()(double x, double y) const {
+        const Eigen::Vector2d raw =
+            camera_.distortPixel(core::applyHomography(toUndistorted_, Eigen::Vector2d(x, y)));
+        return {cvRound(raw.x()), cvRound(raw.y())};
+    }
+
+private:
+    Eigen::Matrix3d toUndistorted_;
+    core::CameraModel camera_;
+};
+
+void drawDisplayOutline(const core::Calibration& calibration, int thickness, cv::Mat& image) {
+    const DisplayToCamera toCamera(calibration, 0.0);
+    const double width = calibration.displaySize.width, height = calibration.displaySize.height;
+    const cv::Point2d corners[] = {{0, 0}, {width, 0}, {width, height}, {0, height}};
+    std::vector<cv::Point> outline;
+    for (int edge = 0; edge < 4; ++edge) {
+        const cv::Point2d from = corners[edge], to = corners[(edge + 1) % 4];
+        for (int i = 0; i < kOutlineSamplesPerEdge; ++i) {
+            const cv::Point2d point = from + (to - from) * (double(i) / kOutlineSamplesPerEdge);
+            outline.push_back(toCamera(point.x, point.y));
+        }
+    }
+    cv::polylines(image, outline, true, kOutlineColour, thickness, cv::LINE_AA);
+}
+
+void drawContact(const core::Calibration& calibration, const core::Contact& contact, int radius,
+                 cv::Mat& image) {
+    const cv::Point at = DisplayToCamera(calibration, contact.heightMm)(contact.x, contact.y);
+    const cv::Scalar colour = contact.palm       ? kPalmColour
+                              : contact.touching ? kTouchingColour
+                                                 : kHoveringColour;
+    cv::circle(image, at, radius, colour, contact.touching ? cv::FILLED : std::max(1, radius / 3),
+               cv::LINE_AA);
+    char label[48];
+    std::snprintf(label, sizeof label, "%u %.1f mm", contact.id, contact.heightMm);
+    cv::putText(image, label, at + cv::Point(radius + 2, -radius), cv::FONT_HERSHEY_SIMPLEX, radius / 16.0,
+                colour, 1, cv::LINE_AA);
+}
+
+}  // namespace
+
+void drawOverlay(const std::optional<core::Calibration>& calibration, const core::Contacts& contacts,
+                 cv::Mat& image) {
+    // Sizes follow the image so that the drawing reads the same on any camera.
+    const int scale = std::max(1, image.cols / 640);
+    if (!calibration) {
+        cv::putText(image, "not calibrated", cv::Point(8 * scale, 24 * scale), cv::FONT_HERSHEY_SIMPLEX,
+                    0.7 * scale, kTouchingColour, scale, cv::LINE_AA);
+        return;
+    }
+    drawDisplayOutline(*calibration, scale, image);
+    for (const core::Contact& contact : contacts)
+        drawContact(*calibration, contact, 6 * scale, image);
+}
+
+}  // namespace everytouch::service
