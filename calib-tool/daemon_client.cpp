@@ -223,6 +223,10 @@ std::variant<DaemonClient::CalibrationResult, Failure> DaemonClient::calibrate(
         r = sd_bus_message_append(message.get(), "{sv}", "card_width_mm", "d", *options.cardWidthMm);
     if (r >= 0 && options.cardHeightMm)
         r = sd_bus_message_append(message.get(), "{sv}", "card_height_mm", "d", *options.cardHeightMm);
+    if (r >= 0 && options.views)
+        r = sd_bus_message_append(message.get(), "{sv}", "views", "u", *options.views);
+    if (r >= 0 && options.viewTimeoutS)
+        r = sd_bus_message_append(message.get(), "{sv}", "view_timeout_s", "d", *options.viewTimeoutS);
     if (r >= 0)
         r = sd_bus_message_close_container(message.get());
     io::UniqueBusError error;

@@ -44,6 +44,8 @@ public:
         std::optional<std::uint32_t> frames;
         std::optional<double> cardWidthMm;
         std::optional<double> cardHeightMm;
+        std::optional<std::uint32_t> views;
+        std::optional<double> viewTimeoutS;
     };
     using ProgressHandler =
         std::function<void(const std::string& step, double fraction, const std::string& message)>;

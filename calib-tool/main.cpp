@@ -129,6 +129,11 @@ void showProgress(const std::string& step, double fraction, const std::string& m
         std::fprintf(stderr, "%3d%% %s: %s\n", percent, step.c_str(), message.c_str());
         return;
     }
+    // A new instruction starts a new line, so that the earlier ones stay readable above it.
+    static std::string shown;
+    if (!shown.empty() && message != shown)
+        std::fprintf(stderr, "\n");
+    shown = message;
     constexpr int kWidth = 30;
     const int filled = percent * kWidth / 100;
     std::fprintf(stderr, "\r\033[K[%s%s] %3d%% %s: %s", std::string(filled, '#').c_str(),
@@ -180,15 +185,21 @@ int main(int argc, char** argv) {
     bool noSave = false;
     CLI::App* calibrateCommand = app.add_subcommand(
         "calibrate",
-        "Calibrate: projector (projected chessboard), table (a card on the table) or full (both)");
+        "Calibrate: projector (once per rig: the card on the table, then on a board in several tilts), "
+        "table (a card on the table) or full (both)");
     calibrateCommand->add_option("step", step, "projector, table or full")
         ->check(CLI::IsMember({"projector", "table", "full"}))
         ->capture_default_str();
-    calibrateCommand->add_option("--frames", options.frames, "Frame pairs captured for each step (1-120)");
+    calibrateCommand->add_option("--frames", options.frames, "Frame pairs the table step averages (1-120)");
     calibrateCommand->add_option("--card-width-mm", options.cardWidthMm,
-                                 "Width of the card the table step looks for (default 85.5)");
+                                 "Width of the card's dark stripe the steps look for (default 85.5)");
     calibrateCommand->add_option("--card-height-mm", options.cardHeightMm,
-                                 "Height of the card the table step looks for (default 12.5)");
+                                 "Height of the card's dark stripe the steps look for (default 12.5)");
+    calibrateCommand->add_option("--views", options.views,
+                                 "Poses the projector step takes, the table first (3-20, default 6)");
+    calibrateCommand->add_option("--view-timeout-s", options.viewTimeoutS,
+                                 "The projector step fails when no new pose is taken for this many seconds "
+                                 "(1-3600, default 60)");
     calibrateCommand->add_flag("--no-save", noSave,
                                "Keep the new calibration only until everytouchd restarts");
 

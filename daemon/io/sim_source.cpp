@@ -43,7 +43,10 @@ std::optional<core::Frame> SimSource::next() {
     if (const auto end = simulator_->endFrame(); end && index_ >= *end)
         return std::nullopt;
     core::Frame frame;
-    simulator_->render(index_, frame, truth_);
+    {
+        std::lock_guard lock(renderMutex_);
+        simulator_->render(index_, frame, truth_);
+    }
     truthIndex_ = index_;
     if (paced_) {
         if (index_ == simulator_->firstFrame())
@@ -52,6 +55,11 @@ std::optional<core::Frame> SimSource::next() {
     }
     ++index_;
     return frame;
+}
+
+void SimSource::projectImage(const cv::Mat& projectorImage) {
+    std::lock_guard lock(renderMutex_);
+    simulator_->projectImage(projectorImage);
 }
 
 std::optional<RigDescription> SimSource::rig() const {

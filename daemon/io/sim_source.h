@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,9 +30,16 @@ public:
     // Everything the renderer knows about the last frame: every fingertip, the hand mask, visible heights.
     const sim::FrameTruth& frameTruth() const { return truth_; }
 
+    // What the simulated projector shows from the next frame on instead of the content (8-bit gray or BGR,
+    // projector size); an empty image returns to the content. Safe to call while another thread takes
+    // frames. Throws std::invalid_argument for another size or type.
+    void projectImage(const cv::Mat& projectorImage);
+    cv::Size projectorSize() const { return simulator_->calibration().projectorSize; }
+
 private:
     std::string spec_;
     std::unique_ptr<sim::Simulator> simulator_;
+    std::mutex renderMutex_;  // the camera thread renders while the calibration changes the projected image
     bool paced_;
     std::uint64_t index_ = 0;
     std::chrono::steady_clock::time_point start_;

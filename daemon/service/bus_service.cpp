@@ -61,10 +61,15 @@ CalibrationOptions readCalibrationOptions(sd_bus_message* message) {
             options.cardWidthMm = readOption<double>(message, key, "d");
         else if (std::strcmp(key, "card_height_mm") == 0)
             options.cardHeightMm = readOption<double>(message, key, "d");
+        else if (std::strcmp(key, "views") == 0)
+            options.views = readOption<std::uint32_t>(message, key, "u");
+        else if (std::strcmp(key, "view_timeout_s") == 0)
+            options.viewTimeoutS = readOption<double>(message, key, "d");
         else
             throw BusError(SD_BUS_ERROR_INVALID_ARGS,
                            std::string("Unknown Calibrate option \"") + key +
-                               "\"; known: frames (u), card_width_mm (d), card_height_mm (d)");
+                               "\"; known: frames (u), card_width_mm (d), card_height_mm (d), views (u), "
+                               "view_timeout_s (d)");
         check(sd_bus_message_exit_container(message), "Calibrate options");
     }
     check(r, "Calibrate options");

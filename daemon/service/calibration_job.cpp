@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "service/projector_step.h"
 #include "service/table_set_up_step.h"
 
 namespace everytouch::service {
@@ -12,21 +13,20 @@ namespace {
 
 constexpr unsigned kMaxPairsPerStep = 120;  // one second of a 120 Hz camera
 constexpr double kMaxCardSideMm = 1000.0;   // larger than any table the rig sees
+constexpr unsigned kMinViews = 3;           // the pair calibration needs the card on three surfaces
+constexpr unsigned kMaxViews = 20;          // beyond this the views add time, not accuracy
+constexpr double kMaxViewTimeoutS = 3600.0;
 
-// The one-time calibration of the rigid projector-camera pair needs a board in several tilted poses, each
-// captured on the user's word; core::calibrateProjectorCameraPair exists, the capture dialogue does not yet.
 CalibrationStep projectorStep() {
     return {"projector",
-            "the one-time calibration of the projector-camera pair from several poses of a board",
-            "Hold the board still in the next pose", nullptr};
+            "the one-time calibration of the projector-camera pair from the table and a board in several "
+            "tilts",
+            calibrateProjectorCameraPairStep};
 }
 
 CalibrationStep tableStep() {
-    return {
-        "table", "the table set-up from the projected chessboard and the card (H_CP, H_TC, keystone)",
-        "The projector shows a chessboard: keep the table clear and lay the card flat in the white border "
-        "below the board",
-        setUpTableFromPairs};
+    return {"table", "the table set-up from the projected chessboard and the card (H_CP, H_TC, keystone)",
+            setUpTableStep};
 }
 
 }  // namespace
@@ -39,6 +39,10 @@ std::optional<std::string> CalibrationOptions::validate() const {
         if (!std::isfinite(value) || value <= 0.0 || value > kMaxCardSideMm)
             return std::string(name) + ": must be more than 0 and at most " +
                    std::to_string(int(kMaxCardSideMm)) + " mm";
+    if (views < kMinViews || views > kMaxViews)
+        return "views: must be from " + std::to_string(kMinViews) + " to " + std::to_string(kMaxViews);
+    if (!(viewTimeoutS >= 1.0 && viewTimeoutS <= kMaxViewTimeoutS))
+        return "view_timeout_s: must be from 1 to " + std::to_string(int(kMaxViewTimeoutS)) + " s";
     return std::nullopt;
 }
 
@@ -52,31 +56,28 @@ std::optional<std::vector<CalibrationStep>> calibrationSteps(std::string_view re
     return std::nullopt;
 }
 
-std::optional<std::string> missingEstimator(const std::vector<CalibrationStep>& steps) {
-    for (const CalibrationStep& step : steps)
-        if (!step.estimator)
-            return "The " + step.name + " step (" + step.description + ") is not part of this build yet";
-    return std::nullopt;
-}
-
 CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
                                   const CalibrationOptions& options,
-                                  const std::optional<core::Calibration>& start,
-                                  const CaptureFunction& capture, const ProgressFunction& progress) {
+                                  const std::optional<core::Calibration>& start, cv::Size projectorSize,
+                                  const CaptureFunction& capture, const ShowFunction& show,
+                                  const ProgressFunction& progress) {
     CalibrationOutcome outcome;
     std::optional<core::Calibration> current = start;
     const double stepShare = 1.0 / static_cast<double>(steps.size());
     for (std::size_t i = 0; i < steps.size(); ++i) {
         const CalibrationStep& step = steps[i];
         const double begun = stepShare * static_cast<double>(i);
-        progress(step.name, begun, step.prompt);
-        const std::optional<std::vector<core::FramePair>> pairs = capture(options.pairsPerStep);
-        if (!pairs) {
-            outcome.message = "the " + step.name + " step got no camera frames";
-            return outcome;
-        }
-        progress(step.name, begun + 0.5 * stepShare, "Estimating " + step.description);
-        EstimateResult result = step.estimator(*pairs, current, options);
+        const StepContext context{options,
+                                  current,
+                                  projectorSize,
+                                  capture,
+                                  show,
+                                  [&](double fraction, const std::string& message) {
+                                      progress(step.name, begun + stepShare * std::clamp(fraction, 0.0, 1.0),
+                                               message);
+                                  },
+                                  i > 0};
+        EstimateResult result = step.run(context);
         if (!result.calibration) {
             outcome.message = "the " + step.name + " step failed: " + result.problem;
             return outcome;

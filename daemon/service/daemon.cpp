@@ -99,9 +99,17 @@ int Daemon::run() {
     const io::RigSpec spec = io::RigSpec::parse(rigText);
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
-    source_ = openFrameSource(spec, options_.fast);
-    ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe();
+    OpenedRig opened = openRig(spec, options_.fast);
+    source_ = std::move(opened.source);
+    projector_ = std::move(opened.projector);
+    recordedRig_ = spec.kind == io::RigSpec::Kind::Replay;
+    ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe()
+                 << (projector_ ? ", calibration images on " + projector_->describe() : std::string());
     const std::optional<io::RigDescription> rig = source_->rig();
+    if (projector_)
+        projectorSize_ = projector_->size();
+    else if (rig)
+        projectorSize_ = rig->calibration.projectorSize;
 
     loadCalibration(rig);
 
@@ -378,48 +386,65 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
                        "A calibration is already running; wait for its CalibrationFinished signal");
     if (loop_->finished())
         throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
-    if (const std::optional<std::string> missing = missingEstimator(*steps))
-        throw BusError(bus::kErrorCalibrationFailed, *missing + "; the current calibration stays active");
+    if (!projector_ && !recordedRig_)
+        throw BusError(bus::kErrorCalibrationFailed,
+                       "This rig has no projector output, so the calibration cannot show its chessboard; the "
+                       "current calibration stays active");
+    if (projectorSize_.empty() && !store_->active())
+        throw BusError(
+            bus::kErrorCalibrationFailed,
+            "The projector's size is unknown: this rig has no projector output and no calibration");
 
     calibration_ = std::make_unique<CalibrationRun>();
     CalibrationRun* run = calibration_.get();
-    run->thread = std::thread([this, run, steps = std::move(*steps), options, start = store_->active()] {
-        const CaptureFunction capture = [this, run](std::size_t pairs) {
-            struct Handover {
-                std::mutex mutex;
-                std::condition_variable arrived;
-                std::optional<std::vector<core::FramePair>> pairs;
+    const cv::Size projectorSize = !projectorSize_.empty() ? projectorSize_ : store_->active()->projectorSize;
+    run->thread =
+        std::thread([this, run, steps = std::move(*steps), options, start = store_->active(), projectorSize] {
+            const CaptureFunction capture = [this, run](std::size_t pairs) {
+                struct Handover {
+                    std::mutex mutex;
+                    std::condition_variable arrived;
+                    std::optional<std::vector<core::FramePair>> pairs;
+                };
+                auto handover = std::make_shared<Handover>();
+                const FrameTap::Ticket ticket =
+                    loop_->tap().request(pairs, [handover](std::vector<core::FramePair>&& captured) {
+                        std::lock_guard lock(handover->mutex);
+                        handover->pairs = std::move(captured);
+                        handover->arrived.notify_all();
+                    });
+                const auto deadline = Clock::now() + captureTimeout(pairs);
+                std::unique_lock lock(handover->mutex);
+                while (!handover->pairs && !run->cancelled && Clock::now() < deadline)
+                    handover->arrived.wait_for(lock, std::chrono::milliseconds(100));
+                if (!handover->pairs)
+                    loop_->tap().cancel(ticket);
+                return std::move(handover->pairs);
             };
-            auto handover = std::make_shared<Handover>();
-            const FrameTap::Ticket ticket =
-                loop_->tap().request(pairs, [handover](std::vector<core::FramePair>&& captured) {
-                    std::lock_guard lock(handover->mutex);
-                    handover->pairs = std::move(captured);
-                    handover->arrived.notify_all();
+            const ProgressFunction progress = [this](const std::string& step, double fraction,
+                                                     const std::string& message) {
+                inbox_.post([this, step, fraction, message] {
+                    if (bus_)
+                        bus_->calibrationProgress(step, fraction, message);
                 });
-            const auto deadline = Clock::now() + captureTimeout(pairs);
-            std::unique_lock lock(handover->mutex);
-            while (!handover->pairs && !run->cancelled && Clock::now() < deadline)
-                handover->arrived.wait_for(lock, std::chrono::milliseconds(100));
-            if (!handover->pairs)
-                loop_->tap().cancel(ticket);
-            return std::move(handover->pairs);
-        };
-        const ProgressFunction progress = [this](const std::string& step, double fraction,
-                                                 const std::string& message) {
-            inbox_.post([this, step, fraction, message] {
-                if (bus_)
-                    bus_->calibrationProgress(step, fraction, message);
-            });
-        };
-        CalibrationOutcome outcome;
-        try {
-            outcome = runCalibration(steps, options, start, capture, progress);
-        } catch (const std::exception& error) {
-            outcome.message = error.what();
-        }
-        inbox_.post([this, outcome] { finishCalibration(outcome); });
-    });
+            };
+            CalibrationOutcome outcome;
+            try {
+                // Whatever ends the job, the desktop comes back when the lease goes.
+                io::ProjectorLease lease(projector_.get());
+                const ShowFunction show = [this, &lease, &capture](const cv::Mat& projectorImage) {
+                    if (!projector_)
+                        return;
+                    lease.show(projectorImage);
+                    // Frames exposed before the image changed may still be queued, and one may be under way.
+                    capture(kQueueFrames + 2);
+                };
+                outcome = runCalibration(steps, options, start, projectorSize, capture, show, progress);
+            } catch (const std::exception& error) {
+                outcome.message = error.what();
+            }
+            inbox_.post([this, outcome] { finishCalibration(outcome); });
+        });
     refreshState();
 }
 

@@ -15,6 +15,7 @@
 #include "io/console_sink.h"
 #include "io/frame_source.h"
 #include "io/handles.h"
+#include "io/projector_output.h"
 #include "io/recording.h"
 #include "io/rig_spec.h"
 #include "io/touch_log.h"
@@ -140,6 +141,9 @@ private:
     double touchHeightMm_ = 0.0;
 
     std::unique_ptr<io::FrameSource> source_;
+    std::unique_ptr<io::ProjectorOutput> projector_;  // none for a recording
+    bool recordedRig_ = false;                        // the frames come from a recording
+    cv::Size projectorSize_;                          // the panel calibration images are drawn for
     std::unique_ptr<io::RecordingWriter> recorder_;
     std::unique_ptr<io::ConsoleSink> console_;
     std::unique_ptr<io::TouchLogWriter> touchLog_;

@@ -2,16 +2,23 @@
 
 #include "io/input_error.h"
 #include "io/replay_source.h"
+#include "io/sim_projector.h"
 #include "io/sim_source.h"
 
 namespace everytouch::service {
 
-std::unique_ptr<io::FrameSource> openFrameSource(const io::RigSpec& spec, bool fast) {
+OpenedRig openRig(const io::RigSpec& spec, bool fast) {
+    OpenedRig rig;
     switch (spec.kind) {
         case io::RigSpec::Kind::Replay:
-            return std::make_unique<io::ReplaySource>(spec.target, !fast);
-        case io::RigSpec::Kind::Sim:
-            return std::make_unique<io::SimSource>(spec, !fast);
+            rig.source = std::make_unique<io::ReplaySource>(spec.target, !fast);
+            return rig;
+        case io::RigSpec::Kind::Sim: {
+            auto source = std::make_unique<io::SimSource>(spec, !fast);
+            rig.projector = std::make_unique<io::SimProjector>(*source);
+            rig.source = std::move(source);
+            return rig;
+        }
         case io::RigSpec::Kind::Aravis:
         case io::RigSpec::Kind::V4l2:
             throw io::InputError("--rig " + spec.toString(), "",

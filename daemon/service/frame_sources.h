@@ -3,11 +3,19 @@
 #include <memory>
 
 #include "io/frame_source.h"
+#include "io/projector_output.h"
 #include "io/rig_spec.h"
 
 namespace everytouch::service {
 
-// Opens the frame source a --rig spec names. Throws InputError when the spec cannot be served.
-std::unique_ptr<io::FrameSource> openFrameSource(const io::RigSpec& spec, bool fast);
+// What a --rig spec gives the daemon: its frames and, when it has one, the output that shows calibration
+// images on its projector.
+struct OpenedRig {
+    std::unique_ptr<io::FrameSource> source;
+    std::unique_ptr<io::ProjectorOutput> projector;  // none for a recording, which shows what it shows
+};
+
+// Opens the rig a --rig spec names. Throws InputError when the spec cannot be served.
+OpenedRig openRig(const io::RigSpec& spec, bool fast);
 
 }  // namespace everytouch::service

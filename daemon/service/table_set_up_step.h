@@ -24,4 +24,13 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options);
 
+// The same on one texture (8-bit gray or BGR, the scene without the code) under the `current` pair.
+EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibration& current,
+                                     const CalibrationOptions& options);
+
+// The table step as the calibration job runs it: shows the board (tableSetUpChessboard) on white, captures
+// options.pairsPerStep pairs and sets the table up from them (setUpTableFromPairs). After another step of the
+// same job it first waits until the scene has changed and held still, and uses the still spell.
+EstimateResult setUpTableStep(const StepContext& context);
+
 }  // namespace everytouch::service

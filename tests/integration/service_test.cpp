@@ -16,11 +16,14 @@
 #include <gtest/gtest.h>
 
 #include "core/geometry.h"
+#include "core/projector_chessboard.h"
 #include "io/calibration_file.h"
 #include "io/handles.h"
 #include "io/recording.h"
 #include "service/bus_names.h"
 #include "service/table_set_up_step.h"
+#include "sim/rig_geometry.h"
+#include "sim/sim_parameters.h"
 #include "support/coded_recording.h"
 #include "support/file_contents.h"
 #include "support/notify_socket.h"
@@ -166,14 +169,17 @@ protected:
     void startDaemon(const std::vector<std::string>& extra = {},
                      const std::vector<std::pair<std::string, std::string>>& environment = {},
                      const std::filesystem::path& recording = SharedRecording::path()) {
+        startDaemonOn("replay:" + recording.string(), extra, environment);
+    }
+
+    void startDaemonOn(const std::string& rig, const std::vector<std::string>& extra = {},
+                       const std::vector<std::pair<std::string, std::string>>& environment = {}) {
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
         std::vector<std::pair<std::string, std::string>> variables = {
             {"NOTIFY_SOCKET", notify_->path().string()}};
         variables.insert(variables.end(), environment.begin(), environment.end());
         daemon_ = std::make_unique<test::BackgroundProcess>(
-            concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig",
-                    "replay:" + recording.string()},
-                   extra),
+            concat({EVERYTOUCHD_PATH, "--config", configPath().string(), "--rig", rig}, extra),
             dir_ / "everytouchd.log", variables);
         ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     }
@@ -345,17 +351,15 @@ TEST_F(ServiceTest, CalibrateRejectsBadArgumentsWithoutChangingState) {
     EXPECT_TRUE(daemon_->running());
 }
 
-TEST_F(ServiceTest, CalibrateSaysWhichStepsThisBuildCannotRun) {
+TEST_F(ServiceTest, TheProjectorStepSaysWhatItMissesWhenNoPoseComes) {
+    // A recording shows what it shows: here the coded content, without chessboard or card.
     startDaemon();
-    const test::ProcessResult direct = test::runProcess(concat(call("Calibrate"), {"sa{sv}", "full", "0"}));
-    EXPECT_NE(direct.exitCode, 0);
-    EXPECT_THAT(direct.err,
-                HasSubstr("The projector step (the one-time calibration of the projector-camera pair "
-                          "from several poses of a board) is not part of this build yet; the current "
-                          "calibration stays active"));
-    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "projector"});
+    const test::ProcessResult tool = test::runProcess(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--view-timeout-s", "1", "--no-save"});
     EXPECT_EQ(tool.exitCode, 1);
-    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: The projector step"));
+    EXPECT_THAT(tool.err, HasSubstr("projector: Pose 1 of 6: lay the card on the table"));
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: the projector step failed: no pose 1 of 6 was taken "
+                                    "within 1 s (last seen: the projected chessboard is not in view whole"));
     EXPECT_EQ(get("State"), "s \"running\"\n");
     EXPECT_EQ(get("Calibrated"), "b true\n");
 }
@@ -372,7 +376,7 @@ TEST_F(ServiceTest, AFailedCalibrationKeepsThePreviousOne) {
     EXPECT_EQ(get("Calibrated"), "b true\n");
 }
 
-TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
+TEST_F(ServiceTest, ATableRecordingCalibratesWithoutAProjectorOutputAndSaves) {
     // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
     // degrees under the unchanged projector-camera pair.
     const core::Calibration truth = trueRig();
@@ -419,6 +423,121 @@ TEST_F(ServiceTest, TableCalibrationRecoversTheTrueRigAndSavesIt) {
     RecordProperty("stored_worst_projector_to_camera_px", std::to_string(movedWorstPx));
     EXPECT_GT(movedWorstPx, 2.0) << "the stored calibration should have been off before";
     EXPECT_FALSE(saved.validate());
+}
+
+// The truth of a simulated rig: its calibration follows from its parameters.
+core::Calibration simulatedRig(const std::string& scenario) {
+    sim::SimParameters parameters;
+    parameters.scenario = scenario;
+    return sim::rigCalibration(parameters);
+}
+
+// Worst distance between the camera pixel -> projector pixel maps of two calibrations on the table, over the
+// camera pixels the projector lights.
+double worstCameraToProjectorPx(const core::Calibration& found, const core::Calibration& truth) {
+    double worstPx = 0;
+    for (double x = 40; x <= 600; x += 40)
+        for (double y = 40; y <= 440; y += 40) {
+            const Eigen::Vector2d camera = core::applyHomography(truth.projectorToCameraHomography(), {x, y});
+            if (camera.x() < 0 || camera.y() < 0 || camera.x() > truth.cameraSize.width - 1 ||
+                camera.y() > truth.cameraSize.height - 1)
+                continue;
+            worstPx = std::max(worstPx, (core::applyHomography(found.cameraToProjectorHomography(), camera) -
+                                         Eigen::Vector2d(x, y))
+                                            .norm());
+        }
+    return worstPx;
+}
+
+// After a calibration the projector shows the content again: no chessboard in what the camera sees.
+void expectProjectorGivenBack(const std::filesystem::path& dir, const core::Calibration& truth) {
+    const test::ProcessResult snapshot =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "texture", (dir / "after.png").string()});
+    ASSERT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    const cv::Mat texture = cv::imread((dir / "after.png").string(), cv::IMREAD_UNCHANGED);
+    EXPECT_FALSE(
+        core::detectProjectedChessboard(texture, service::tableSetUpChessboard(), truth.projectorSize)
+            .success)
+        << "the calibration chessboard is still projected";
+}
+
+TEST_F(ServiceTest, TableCalibrationOnTheSimulatedRigRecoversItsTruthAndGivesTheProjectorBack) {
+    // The table moved since the stored calibration; the projector-camera pair did not.
+    const core::Calibration truth = simulatedRig("table-setup");
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemonOn("sim:table-setup", {"--fast"});
+
+    const auto start = std::chrono::steady_clock::now();
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    RecordProperty("stored_worst_camera_to_projector_px",
+                   std::to_string(worstCameraToProjectorPx(moved, truth)));
+    RecordProperty("seconds", std::to_string(seconds));
+    EXPECT_LT(worstPx, 0.5);
+    EXPECT_GT(worstCameraToProjectorPx(moved, truth), 2.0) << "the stored calibration should have been off";
+    expectProjectorGivenBack(dir_.path(), truth);
+}
+
+// The table and three tilts of the board (the scenario's first four poses) keep the test short; the pair
+// calibration needs the card on three surfaces.
+TEST_F(ServiceTest, ProjectorCalibrationOnTheSimulatedRigRecoversItsPairAndTable) {
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemonOn("sim:pair-calibration,frame_rate=30", {"--fast"});
+    const auto start = std::chrono::steady_clock::now();
+    const test::ProcessResult tool = test::runProcess(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--views", "4", "--view-timeout-s", "30"});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    EXPECT_THAT(tool.err, HasSubstr("Pose 1 of 4 taken. Pose 2 of 4: tilt the board another way"));
+    EXPECT_THAT(tool.err, HasSubstr("Pose 4 of 4 taken. Estimating the projector-camera pair from 4 poses"));
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    const core::Calibration truth = simulatedRig("pair-calibration");
+    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    RecordProperty("seconds", std::to_string(seconds));
+    EXPECT_LT(worstPx, 0.5);
+    expectProjectorGivenBack(dir_.path(), truth);
+}
+
+TEST_F(ServiceTest, AFailedProjectorStepSaysWhatItMissedAndGivesTheProjectorBack) {
+    // The card lies on the table and nobody brings a board: pose 1 is taken, pose 2 never comes.
+    startDaemonOn("sim:table-setup", {"--fast"});
+    const test::ProcessResult tool = test::runProcess(
+        {EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--view-timeout-s", "2", "--no-save"});
+    EXPECT_EQ(tool.exitCode, 1);
+    EXPECT_THAT(tool.err, HasSubstr("Pose 1 of 6 taken. Pose 2 of 6: tilt the board another way"));
+    EXPECT_THAT(tool.err, HasSubstr("Calibration failed: the projector step failed: no pose 2 of 6 was taken "
+                                    "within 2 s (the scene never held still with something new in view)"));
+    expectProjectorGivenBack(dir_.path(), simulatedRig("table-setup"));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+}
+
+TEST_F(ServiceTest, StoppingTheDaemonMidCalibrationEndsTheJobAndTheTool) {
+    startDaemonOn("sim:table-setup", {"--fast"});
+    test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "calibrate", "projector", "--no-save"},
+                                 dir_ / "calibrate.log");
+    ASSERT_TRUE(waitForProperty("State", "s \"calibrating\""));
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_EQ(tool.wait(kExitTimeout), 1) << tool.output();
 }
 
 TEST_F(ServiceTest, ASecondCalibrationWhileOneRunsIsBusy) {
@@ -644,8 +763,9 @@ TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
         test::runProcess(concat(member, {EVERYTOUCH_CALIB_PATH, "sensitivity", "6"}));
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("TouchHeightMm"), "d 6\n");
-    result = test::runProcess(concat(member, call("Calibrate", {"sa{sv}", "full", "0"})));
-    EXPECT_THAT(result.err, HasSubstr("is not part of this build yet"));
+    result = test::runProcess(
+        concat(member, call("Calibrate", {"sa{sv}", "projector", "1", "view_timeout_s", "d", "1"})));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
 }
 
 TEST_F(ServiceTest, TheToolSaysWhenTheDaemonIsNotRunning) {

@@ -29,13 +29,19 @@ std::vector<core::FramePair> pairsNumbered(std::size_t count, std::uint64_t firs
 // chained through.
 CalibrationStep shiftingStep(const std::string& name, double shift, double rmsPx,
                              std::vector<std::size_t>& pairsSeen) {
-    return {name, name + " description", name + " prompt",
-            [shift, rmsPx, &pairsSeen](const std::vector<core::FramePair>& pairs,
-                                       const std::optional<core::Calibration>& current,
-                                       const CalibrationOptions&) {
-                pairsSeen.push_back(pairs.size());
+    return {name, name + " description", [name, shift, rmsPx, &pairsSeen](const StepContext& context) {
                 EstimateResult result;
-                result.calibration = current.value_or(test::paperLikeCalibration());
+                context.show(cv::Mat(context.projectorSize, CV_8UC1, cv::Scalar(255)));
+                context.progress(0.0, name + " prompt");
+                const std::optional<std::vector<core::FramePair>> pairs =
+                    context.capture(context.options.pairsPerStep);
+                if (!pairs) {
+                    result.problem = "no frames";
+                    return result;
+                }
+                pairsSeen.push_back(pairs->size());
+                context.progress(0.5, name + " estimating");
+                result.calibration = context.current.value_or(test::paperLikeCalibration());
                 result.calibration->displayToProjector(0, 2) += shift;
                 result.rmsPx = rmsPx;
                 return result;
@@ -50,14 +56,6 @@ TEST(CalibrationJob, KnowsItsSteps) {
     EXPECT_FALSE(calibrationSteps("everything"));
 }
 
-TEST(CalibrationJob, ThisBuildNamesTheStepsWithoutEstimator) {
-    const std::optional<std::string> missing = missingEstimator(*calibrationSteps("full"));
-    ASSERT_TRUE(missing);
-    EXPECT_THAT(*missing, HasSubstr("projector step"));
-    EXPECT_THAT(*missing, HasSubstr("not part of this build"));
-    EXPECT_FALSE(missingEstimator(*calibrationSteps("table")));
-}
-
 TEST(CalibrationJob, OptionsAreRangeChecked) {
     EXPECT_FALSE(CalibrationOptions().validate());
     CalibrationOptions options;
@@ -68,6 +66,12 @@ TEST(CalibrationJob, OptionsAreRangeChecked) {
     EXPECT_THAT(options.validate().value_or(""), HasSubstr("card_height_mm"));
     options.cardHeightMm = std::numeric_limits<double>::quiet_NaN();
     EXPECT_TRUE(options.validate());
+    options = CalibrationOptions();
+    options.views = 2;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("views: must be from 3 to 20"));
+    options = CalibrationOptions();
+    options.viewTimeoutS = 0.5;
+    EXPECT_THAT(options.validate().value_or(""), HasSubstr("view_timeout_s: must be from 1 to 3600 s"));
 }
 
 TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
@@ -79,19 +83,22 @@ TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
     std::uint64_t nextIndex = 0;
     std::vector<std::size_t> requested;
     std::vector<ProgressEvent> progress;
+    std::vector<cv::Size> shown;
     const CalibrationOutcome outcome = runCalibration(
-        steps, options, std::nullopt,
+        steps, options, std::nullopt, cv::Size(640, 480),
         [&](std::size_t pairs) {
             requested.push_back(pairs);
             nextIndex += 2 * pairs;
             return std::optional(pairsNumbered(pairs, nextIndex));
         },
+        [&](const cv::Mat& image) { shown.push_back(image.size()); },
         [&](const std::string& step, double fraction, const std::string& message) {
             progress.push_back({step, fraction, message});
         });
     ASSERT_TRUE(outcome.ok) << outcome.message;
     EXPECT_EQ(requested, (std::vector<std::size_t>{3, 3}));
     EXPECT_EQ(pairsSeen, (std::vector<std::size_t>{3, 3}));
+    EXPECT_EQ(shown, (std::vector<cv::Size>{{640, 480}, {640, 480}}));
     ASSERT_TRUE(outcome.calibration);
     EXPECT_DOUBLE_EQ(outcome.calibration->displayToProjector(0, 2), 11.0);
     EXPECT_DOUBLE_EQ(outcome.rmsPx, 0.4);
@@ -107,16 +114,15 @@ TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
 TEST(CalibrationJob, AFailingStepStopsTheJobWithoutACalibration) {
     std::vector<std::size_t> pairsSeen;
     CalibrationStep failing = shiftingStep("first", 1.0, 0.2, pairsSeen);
-    failing.estimator = [](const std::vector<core::FramePair>&, const std::optional<core::Calibration>&,
-                           const CalibrationOptions&) {
+    failing.run = [](const StepContext&) {
         EstimateResult result;
         result.problem = "no chessboard in view";
         return result;
     };
     const std::vector<CalibrationStep> steps = {failing, shiftingStep("second", 10.0, 0.4, pairsSeen)};
     const CalibrationOutcome outcome = runCalibration(
-        steps, CalibrationOptions(), test::paperLikeCalibration(),
-        [](std::size_t pairs) { return std::optional(pairsNumbered(pairs, 0)); },
+        steps, CalibrationOptions(), test::paperLikeCalibration(), cv::Size(640, 480),
+        [](std::size_t pairs) { return std::optional(pairsNumbered(pairs, 0)); }, [](const cv::Mat&) {},
         [](const std::string&, double, const std::string&) {});
     EXPECT_FALSE(outcome.ok);
     EXPECT_FALSE(outcome.calibration);
@@ -127,11 +133,11 @@ TEST(CalibrationJob, AFailingStepStopsTheJobWithoutACalibration) {
 TEST(CalibrationJob, NoFramesIsAFailure) {
     std::vector<std::size_t> pairsSeen;
     const CalibrationOutcome outcome = runCalibration(
-        {shiftingStep("only", 1.0, 0.1, pairsSeen)}, CalibrationOptions(), std::nullopt,
-        [](std::size_t) { return std::optional<std::vector<core::FramePair>>(); },
+        {shiftingStep("only", 1.0, 0.1, pairsSeen)}, CalibrationOptions(), std::nullopt, cv::Size(640, 480),
+        [](std::size_t) { return std::optional<std::vector<core::FramePair>>(); }, [](const cv::Mat&) {},
         [](const std::string&, double, const std::string&) {});
     EXPECT_FALSE(outcome.ok);
-    EXPECT_THAT(outcome.message, HasSubstr("got no camera frames"));
+    EXPECT_THAT(outcome.message, HasSubstr("the only step failed: no frames"));
     EXPECT_TRUE(pairsSeen.empty());
 }
 

@@ -92,3 +92,68 @@ TEST(TableSetUpStep, SaysWhatIsMissing) {
 
 }  // namespace
 }  // namespace everytouch::service
+
+namespace everytouch::service {
+namespace {
+
+// A stream of pairs: `seconds` of each scene in turn, 30 pairs per second, each scene's pairs alternating
+// between two renderings so that the noise changes.
+std::vector<core::FramePair> sceneStream(
+    const std::vector<std::pair<std::vector<core::FramePair>, double>>& scenes) {
+    std::vector<core::FramePair> stream;
+    for (const auto& [renderings, seconds] : scenes)
+        for (int i = 0; i < seconds * 30; ++i) {
+            core::FramePair pair = renderings[static_cast<std::size_t>(i) % renderings.size()];
+            pair.positive.timestampUs = static_cast<std::int64_t>(stream.size()) * 33'333;
+            pair.negative.timestampUs = pair.positive.timestampUs + 16'666;
+            pair.positive.index = 2 * stream.size();
+            pair.negative.index = pair.positive.index + 1;
+            stream.push_back(pair);
+        }
+    return stream;
+}
+
+EstimateResult runAfterAnotherStep(const std::vector<core::FramePair>& stream, const core::Calibration& rig,
+                                   double viewTimeoutS) {
+    CalibrationOptions options;
+    options.pairsPerStep = 4;
+    options.viewTimeoutS = viewTimeoutS;
+    const std::optional<core::Calibration> current = rig;
+    std::size_t next = 0;
+    const StepContext context{options,
+                              current,
+                              rig.projectorSize,
+                              [&](std::size_t count) -> std::optional<std::vector<core::FramePair>> {
+                                  if (next + count > stream.size())
+                                      return std::nullopt;
+                                  next += count;
+                                  return std::vector<core::FramePair>(
+                                      stream.begin() + static_cast<std::ptrdiff_t>(next - count),
+                                      stream.begin() + static_cast<std::ptrdiff_t>(next));
+                              },
+                              [](const cv::Mat&) {},
+                              [](double, const std::string&) {},
+                              true};
+    return setUpTableStep(context);
+}
+
+TEST(TableSetUpStep, AfterAnotherStepWaitsUntilTheBoardIsTakenAway) {
+    const core::Calibration rig = distortedRig();
+    const Eigen::Vector3d middle(160, 230, 0);
+    const Eigen::Isometry3d tilt = Eigen::Translation3d(middle + Eigen::Vector3d(0, 0, 50)) *
+                                   Eigen::AngleAxisd(20 * M_PI / 180, Eigen::Vector3d::UnitY()) *
+                                   Eigen::Translation3d(-middle);
+    // The board of the previous step's last pose, without the card: the set-up fails on it.
+    const std::vector<core::FramePair> board =
+        capturedPairs(test::onSurface(rig, tilt), std::nullopt, 1, 2.0);
+    const std::vector<core::FramePair> table = capturedPairs(rig, stripeBelowTheBoard(rig), 2, 2.0);
+    const EstimateResult result = runAfterAnotherStep(sceneStream({{board, 1.0}, {table, 2.0}}), rig, 10.0);
+    ASSERT_TRUE(result.calibration) << result.problem;
+    EXPECT_LT(result.rmsPx, 0.5);
+
+    const EstimateResult waited = runAfterAnotherStep(sceneStream({{board, 3.0}}), rig, 2.0);
+    EXPECT_EQ(waited.problem, "the scene did not change and hold still again within 2 s");
+}
+
+}  // namespace
+}  // namespace everytouch::service
