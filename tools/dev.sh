@@ -61,8 +61,12 @@ sanitize)
     install_missing_packages
     # Warnings are enforced by the normal build; GCC's flow analysis under ASan reports false positives.
     build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF -DEVERYTOUCH_WERROR=OFF
+    # The projector step end to end on the simulated rig renders some 500 frames of a moving board, minutes
+    # under ASan; the sanitizers still see the same step through ProjectorStep.* (rendered poses) and the
+    # simulated table calibration, and the normal build runs it end to end.
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-        ctest --test-dir build-sanitize --output-on-failure -j "$jobs" "$@"
+        ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
+        -E '^ServiceTest\.ProjectorCalibrationOnTheSimulatedRig' "$@"
     ;;
 format)
     cpp_files | xargs clang-format -i
