@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -33,6 +34,8 @@ struct EstimateResult {
     std::optional<core::Calibration> calibration;
     double rmsPx = 0.0;
     std::string problem;
+
+    static EstimateResult failed(std::string problem) { return {std::nullopt, 0.0, std::move(problem)}; }
 };
 
 // Captures the next `pairs` frame pairs; nothing when none came (camera gone, job cancelled).

@@ -2,22 +2,14 @@
 
 #include <cstdio>
 
-#include "core/keystone.h"
 #include "core/pair_calibration.h"
 #include "core/projector_camera_pair.h"
-#include "core/table_setup.h"
 #include "service/pose_capture.h"
 #include "service/table_set_up_step.h"
 
 namespace everytouch::service {
 
 namespace {
-
-EstimateResult failure(const std::string& problem) {
-    EstimateResult result;
-    result.problem = problem;
-    return result;
-}
 
 std::string poseLabel(std::size_t pose, unsigned views) {
     return "Pose " + std::to_string(pose) + " of " + std::to_string(views);
@@ -70,7 +62,7 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     while (!capture || capture->views().size() < options.views) {
         std::optional<std::vector<core::FramePair>> pairs = context.capture(1);
         if (!pairs || pairs->empty())
-            return failure("it got no camera frames");
+            return EstimateResult::failed("it got no camera frames");
         const core::FramePair& pair = pairs->front();
         const std::int64_t nowUs = pair.latest().timestampUs;
         if (!capture) {
@@ -103,12 +95,12 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
                 break;
         }
         if ((nowUs - lastViewUs) * 1e-6 > options.viewTimeoutS)
-            return failure("no pose " + std::to_string(pose) + " of " + std::to_string(options.views) +
-                           " was taken within " + formatSeconds(options.viewTimeoutS) + " s (" +
-                           (lastProblem.empty()
-                                ? std::string("the scene never held still with something new in view")
-                                : "last seen: " + lastProblem) +
-                           ")");
+            return EstimateResult::failed(
+                "no pose " + std::to_string(pose) + " of " + std::to_string(options.views) +
+                " was taken within " + formatSeconds(options.viewTimeoutS) + " s (" +
+                (lastProblem.empty() ? std::string("the scene never held still with something new in view")
+                                     : "last seen: " + lastProblem) +
+                ")");
     }
 
     context.progress(viewShare * options.views, poseLabel(options.views, options.views) +
@@ -120,21 +112,13 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     pairOptions.rectangleSizeMm = cardSizeMm;
     const core::PairCalibration pair = core::calibrateProjectorCameraPair(capture->views(), pairOptions);
     if (!pair.success)
-        return failure(pair.message);
+        return EstimateResult::failed(pair.message);
 
-    core::TableSetupOptions tableOptions;
-    tableOptions.rectangleSizeMm = cardSizeMm;
-    const core::TableSetup table = core::setUpTable(pair.pair, capture->views().front(), tableOptions);
-    if (!table.success)
-        return failure("the table in pose 1: " + table.message);
-    EstimateResult result;
-    result.calibration = table.calibration;
-    result.calibration->displaySize = context.current ? context.current->displaySize : context.projectorSize;
-    const core::KeystoneFit keystone =
-        core::fitDisplayToTable(*result.calibration, result.calibration->displaySize);
-    if (!keystone.success)
-        return failure("fitting the display into the lit area: " + keystone.message);
-    result.calibration->displayToProjector = keystone.displayToProjector;
+    EstimateResult result =
+        calibrationOverTable(pair.pair, capture->views().front(), cardSizeMm,
+                             context.current ? context.current->displaySize : context.projectorSize);
+    if (!result.calibration)
+        return EstimateResult::failed("the table in pose 1: " + result.problem);
     result.rmsPx = pair.rmsPx.all;
     return result;
 }

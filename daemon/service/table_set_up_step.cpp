@@ -32,12 +32,6 @@ cv::Mat averageTexture(const std::vector<core::FramePair>& pairs) {
     return average;
 }
 
-EstimateResult failure(const std::string& problem) {
-    EstimateResult result;
-    result.problem = problem;
-    return result;
-}
-
 // Waits, pair by pair, until the scene has changed and then held still, and gives the still spell's average
 // texture (gray); the problem when it does not within the options' view time-out.
 std::optional<std::string> awaitNewStillScene(const StepContext& context, cv::Mat& stillTexture) {
@@ -80,7 +74,7 @@ core::ChessboardOptions tableSetUpChessboard() {
 
 EstimateResult setUpTableStep(const StepContext& context) {
     if (!context.current)
-        return failure(
+        return EstimateResult::failed(
             "it needs the projector-camera pair's calibration (both lenses and their pose), and "
             "there is none; run the projector step first");
     cv::Mat board;
@@ -95,14 +89,14 @@ EstimateResult setUpTableStep(const StepContext& context) {
         context.progress(0.0, "Take the board away. " + prompt);
         cv::Mat texture;
         if (const std::optional<std::string> problem = awaitNewStillScene(context, texture))
-            return failure(*problem);
+            return EstimateResult::failed(*problem);
         context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
         return setUpTableFromTexture(texture, *context.current, context.options);
     }
     context.progress(0.0, prompt);
     const std::optional<std::vector<core::FramePair>> pairs = context.capture(context.options.pairsPerStep);
     if (!pairs)
-        return failure("it got no camera frames");
+        return EstimateResult::failed("it got no camera frames");
     context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
     return setUpTableFromPairs(*pairs, context.current, context.options);
 }
@@ -111,11 +105,11 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options) {
     if (!current)
-        return failure(
+        return EstimateResult::failed(
             "it needs the projector-camera pair's calibration (both lenses and their pose), and "
             "there is none");
     if (pairs.empty())
-        return failure("no frames");
+        return EstimateResult::failed("no frames");
     return setUpTableFromTexture(averageTexture(pairs), *current, options);
 }
 
@@ -126,12 +120,12 @@ EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibra
     const core::ChessboardDetection board =
         core::detectProjectedChessboard(texture, tableSetUpChessboard(), current.projectorSize);
     if (!board.success)
-        return failure("the projected chessboard: " + board.message);
+        return EstimateResult::failed("the projected chessboard: " + board.message);
     core::TableRectangleOptions cardOptions;
     cardOptions.sizeMm = {options.cardWidthMm, options.cardHeightMm};
     const core::TableRectangleDetection card = core::findTableRectangle(texture, cardOptions, pair.camera);
     if (!card.success)
-        return failure("the card: " + card.message);
+        return EstimateResult::failed("the card: " + card.message);
 
     core::PlaneView table;
     table.cameraPoints = board.cameraCorners;
@@ -140,18 +134,23 @@ EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibra
     for (std::size_t corner = 0; corner < rawCorners.size(); ++corner)
         rawCorners[corner] = pair.camera.distortPixel(card.corners[corner]);
     table.rectangleCorners = rawCorners;
+    return calibrationOverTable(pair, table, cardOptions.sizeMm, current.displaySize);
+}
+
+EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const core::PlaneView& table,
+                                    cv::Size2d cardSizeMm, cv::Size displaySize) {
     core::TableSetupOptions setUpOptions;
-    setUpOptions.rectangleSizeMm = cardOptions.sizeMm;
+    setUpOptions.rectangleSizeMm = cardSizeMm;
     const core::TableSetup setUp = core::setUpTable(pair, table, setUpOptions);
     if (!setUp.success)
-        return failure(setUp.message);
+        return EstimateResult::failed(setUp.message);
 
     EstimateResult result;
     result.calibration = setUp.calibration;
-    result.calibration->displaySize = current.displaySize;
-    const core::KeystoneFit keystone = core::fitDisplayToTable(*result.calibration, current.displaySize);
+    result.calibration->displaySize = displaySize;
+    const core::KeystoneFit keystone = core::fitDisplayToTable(*result.calibration, displaySize);
     if (!keystone.success)
-        return failure("fitting the display into the lit area: " + keystone.message);
+        return EstimateResult::failed("fitting the display into the lit area: " + keystone.message);
     result.calibration->displayToProjector = keystone.displayToProjector;
     result.rmsPx = setUp.rmsPx.all;
     return result;

@@ -5,6 +5,8 @@
 
 #include "core/calibration.h"
 #include "core/frame.h"
+#include "core/plane_view.h"
+#include "core/projector_camera_pair.h"
 #include "core/projector_chessboard.h"
 #include "service/calibration_job.h"
 
@@ -27,6 +29,13 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
 // The same on one texture (8-bit gray or BGR, the scene without the code) under the `current` pair.
 EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibration& current,
                                      const CalibrationOptions& options);
+
+// The calibration of `pair` over the table seen in `table` (the chessboard's corners and the card's, raw
+// camera pixels): the table's pose (core::setUpTable) and the display of displaySize fitted undistorted into
+// the lit area (core::fitDisplayToTable); RMS of the set-up. Fails, saying why, when either does not work
+// out.
+EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const core::PlaneView& table,
+                                    cv::Size2d cardSizeMm, cv::Size displaySize);
 
 // The table step as the calibration job runs it: shows the board (tableSetUpChessboard) on white, captures
 // options.pairsPerStep pairs and sets the table up from them (setUpTableFromPairs). After another step of the

@@ -1,5 +1,7 @@
 #include "support/test_rig.h"
 
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 namespace everytouch::test {
@@ -44,6 +46,24 @@ io::RigDescription paperLikeRig(unsigned seed) {
     cv::RNG rng(seed);
     rng.fill(rig.pattern, cv::RNG::UNIFORM, 0, 2);
     return rig;
+}
+
+core::Calibration distortedPaperLikeCalibration() {
+    core::Calibration rig = paperLikeCalibration();
+    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
+    return rig;
+}
+
+Eigen::Isometry3d tiltedBoard(double axisDeg, double tiltDeg, double liftMm) {
+    const Eigen::Vector3d middle(160, 230, 0);
+    const Eigen::Vector3d axis(std::cos(axisDeg * M_PI / 180), std::sin(axisDeg * M_PI / 180), 0);
+    return Eigen::Translation3d(middle + Eigen::Vector3d(0, 0, liftMm)) *
+           Eigen::AngleAxisd(tiltDeg * M_PI / 180, axis) * Eigen::Translation3d(-middle);
+}
+
+std::vector<Eigen::Isometry3d> calibrationPoses() {
+    return {Eigen::Isometry3d::Identity(), tiltedBoard(0, 25, 40),   tiltedBoard(0, -12, 50),
+            tiltedBoard(90, 25, 40),       tiltedBoard(90, -25, 60), tiltedBoard(45, 20, 80)};
 }
 
 }  // namespace everytouch::test

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <vector>
+
+#include <Eigen/Geometry>
 #include <opencv2/core/mat.hpp>
 
 #include "core/calibration.h"
@@ -14,5 +17,16 @@ core::Calibration paperLikeCalibration();
 
 // The calibration above, a random binary pattern of projector size and delta 10.
 io::RigDescription paperLikeRig(unsigned seed = 1);
+
+// paperLikeCalibration with a lens that bends lines by a few pixels towards the frame's edges (k1 = -0.12,
+// k2 = 0.08): the rig the calibration estimators are measured on.
+core::Calibration distortedPaperLikeCalibration();
+
+// A plain board lifted by liftMm and tilted by tiltDeg about an axis in the table at axisDeg from the table's
+// x axis, through the middle of the area the projector lights; the identity is the table itself.
+Eigen::Isometry3d tiltedBoard(double axisDeg, double tiltDeg, double liftMm);
+
+// The table and five tilts of the board, the pair calibration procedure of docs/calibration.md.
+std::vector<Eigen::Isometry3d> calibrationPoses();
 
 }  // namespace everytouch::test

@@ -16,31 +16,7 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// The paper-like rig with a lens that bends lines by a few pixels towards the frame's edges.
-Calibration truthRig() {
-    Calibration rig = test::paperLikeCalibration();
-    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
-    return rig;
-}
-
-// A plain board lifted by liftMm and tilted by tiltDeg about an axis in the table at axisDeg from the table's
-// x axis, through the middle of the area the projector lights; the identity is the table itself.
-Eigen::Isometry3d board(double axisDeg, double tiltDeg, double liftMm) {
-    const Eigen::Vector3d middle(160, 230, 0);
-    const Eigen::Vector3d axis(std::cos(axisDeg * M_PI / 180), std::sin(axisDeg * M_PI / 180), 0);
-    return Eigen::Translation3d(middle + Eigen::Vector3d(0, 0, liftMm)) *
-           Eigen::AngleAxisd(tiltDeg * M_PI / 180, axis) * Eigen::Translation3d(-middle);
-}
-
-// The table and five tilts of the board, the calibration procedure of docs/calibration.md.
-std::vector<Eigen::Isometry3d> calibrationPoses() {
-    return {Eigen::Isometry3d::Identity(),
-            board(0, 25, 40),
-            board(0, -12, 50),
-            board(90, 25, 40),
-            board(90, -25, 60),
-            board(45, 20, 80)};
-}
+using test::calibrationPoses;
 
 // The stripe centred in the lit part of a surface, along its x axis.
 test::DarkRectangle stripeInTheLight(const Calibration& surfaceRig) {
@@ -98,7 +74,7 @@ PlaneView exactView(const Calibration& surface, bool withStripe) {
 }
 
 TEST(PairCalibration, ExactCorrespondencesGiveTheExactPair) {
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     const ProjectorCameraPair truth = pairOf(rig);
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
@@ -117,7 +93,7 @@ TEST(PairCalibration, ExactCorrespondencesGiveTheExactPair) {
 }
 
 TEST(PairCalibration, DenseCorrespondencesAreThinnedAndViewsWithoutTheRectangleJoinIn) {
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
         views.push_back(exactView(test::onSurface(rig, pose), views.size() < 4));
@@ -133,7 +109,7 @@ TEST(PairCalibration, DenseCorrespondencesAreThinnedAndViewsWithoutTheRectangleJ
 }
 
 TEST(PairCalibration, NeedsTheRectangleOnThreeSurfaces) {
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
         views.push_back(exactView(test::onSurface(rig, pose), views.size() < 2));
@@ -144,17 +120,17 @@ TEST(PairCalibration, NeedsTheRectangleOnThreeSurfaces) {
 
 TEST(PairCalibration, RectanglesOnParallelSurfacesAreNotEnough) {
     // The board only lifted, never tilted: every view sees the same directions.
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     std::vector<PlaneView> views;
     for (double liftMm : {0.0, 30.0, 60.0, 90.0})
-        views.push_back(exactView(test::onSurface(rig, board(0, 0, liftMm)), true));
+        views.push_back(exactView(test::onSurface(rig, test::tiltedBoard(0, 0, liftMm)), true));
     const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
     EXPECT_FALSE(calibration.success);
     EXPECT_THAT(calibration.message, HasSubstr("differ in tilt by 0.0 degrees"));
 }
 
 TEST(PairCalibration, WrongCorrespondencesFailOnTheReprojectionError) {
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
         views.push_back(exactView(test::onSurface(rig, pose), true));
@@ -177,7 +153,7 @@ class RenderedPoses : public ::testing::TestWithParam<RenderedCase> {};
 // calibrated.
 TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
     const RenderedCase scenario = GetParam();
-    const Calibration rig = truthRig();
+    const Calibration rig = test::distortedPaperLikeCalibration();
     const ProjectorCameraPair truth = pairOf(rig);
     std::vector<PlaneView> views;
     unsigned seed = 10;

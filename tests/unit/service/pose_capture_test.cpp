@@ -21,30 +21,7 @@ using ::testing::HasSubstr;
 
 constexpr std::int64_t kPairUs = 33'333;  // pairs at 30 per second
 
-core::Calibration truthRig() {
-    core::Calibration rig = test::paperLikeCalibration();
-    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
-    return rig;
-}
-
-// A plain board lifted by liftMm and tilted by tiltDeg about an axis in the table at axisDeg from its x axis,
-// through the middle of the lit area; the identity is the table itself.
-Eigen::Isometry3d board(double axisDeg, double tiltDeg, double liftMm) {
-    const Eigen::Vector3d middle(160, 230, 0);
-    const Eigen::Vector3d axis(std::cos(axisDeg * M_PI / 180), std::sin(axisDeg * M_PI / 180), 0);
-    return Eigen::Translation3d(middle + Eigen::Vector3d(0, 0, liftMm)) *
-           Eigen::AngleAxisd(tiltDeg * M_PI / 180, axis) * Eigen::Translation3d(-middle);
-}
-
-// The table and five tilts of the board (docs/calibration.md).
-std::vector<Eigen::Isometry3d> calibrationPoses() {
-    return {Eigen::Isometry3d::Identity(),
-            board(0, 25, 40),
-            board(0, -12, 50),
-            board(90, 25, 40),
-            board(90, -25, 60),
-            board(45, 20, 80)};
-}
+using test::calibrationPoses;
 
 // The camera's view of a surface in `pose` while the projector shows the set-up board, the card's stripe in
 // the white border below the board, with 2 DN of sensor noise. Rendered once per pose and seed.
@@ -52,7 +29,8 @@ const cv::Mat& poseImage(std::size_t pose, unsigned seed) {
     static std::map<std::pair<std::size_t, unsigned>, cv::Mat> images;
     cv::Mat& image = images[{pose, seed}];
     if (image.empty()) {
-        const core::Calibration surface = test::onSurface(truthRig(), calibrationPoses()[pose]);
+        const core::Calibration surface =
+            test::onSurface(test::distortedPaperLikeCalibration(), calibrationPoses()[pose]);
         test::SurfaceScene scene;
         scene.rig = surface;
         test::DarkRectangle stripe;
@@ -97,8 +75,8 @@ void move(std::vector<core::FramePair>& pairs, std::size_t pose, double seconds)
 }
 
 PoseCapture captureFor(const PoseCaptureOptions& options = {}) {
-    return PoseCapture(options, tableSetUpChessboard(), truthRig().projectorSize, {85.5, 12.5},
-                       core::pairOf(truthRig()).camera);
+    return PoseCapture(options, tableSetUpChessboard(), test::distortedPaperLikeCalibration().projectorSize,
+                       {85.5, 12.5}, core::pairOf(test::distortedPaperLikeCalibration()).camera);
 }
 
 TEST(PoseCaptureOptions, AreRangeChecked) {
@@ -184,7 +162,7 @@ TEST(PoseCapture, SaysWhatIsMissing) {
     const cv::Mat blank(poseImage(0, 1).size(), CV_8UC1, cv::Scalar(200));
     EXPECT_THAT(capture.attempt(blank).problem, HasSubstr("the projected chessboard is not in view"));
     cv::Mat withoutCard = poseImage(0, 1).clone();
-    const core::Calibration rig = truthRig();
+    const core::Calibration rig = test::distortedPaperLikeCalibration();
     const Eigen::Vector2d card = core::applyHomography(rig.projectorToCameraHomography(), {320, 420});
     cv::circle(withoutCard, cv::Point(int(card.x()), int(card.y())), 60, cv::Scalar(200), cv::FILLED);
     EXPECT_THAT(capture.attempt(withoutCard).problem, HasSubstr("the card's stripe is not in view"));
@@ -203,7 +181,7 @@ StepRun runStep(const std::vector<core::FramePair>& pairs, const CalibrationOpti
     const StepContext context{
         options,
         current,
-        truthRig().projectorSize,
+        test::distortedPaperLikeCalibration().projectorSize,
         [&](std::size_t count) -> std::optional<std::vector<core::FramePair>> {
             if (next + count > pairs.size())
                 return std::nullopt;
@@ -226,7 +204,7 @@ TEST(ProjectorStep, CalibratesThePairFromTheTableAndFiveTiltsTakenByThemselves) 
     const StepRun run = runStep(pairs, CalibrationOptions(), std::nullopt);
     ASSERT_TRUE(run.result.calibration) << run.result.problem;
     EXPECT_LE(run.result.rmsPx, 0.5);
-    EXPECT_EQ(run.shown, std::vector<cv::Size>{truthRig().projectorSize});
+    EXPECT_EQ(run.shown, std::vector<cv::Size>{test::distortedPaperLikeCalibration().projectorSize});
     ASSERT_FALSE(run.progress.empty());
     EXPECT_THAT(run.progress.front().second, HasSubstr("Pose 1 of 6: lay the card on the table"));
     EXPECT_THAT(run.progress[1].second,
@@ -236,7 +214,7 @@ TEST(ProjectorStep, CalibratesThePairFromTheTableAndFiveTiltsTakenByThemselves) 
         EXPECT_GE(run.progress[i].first, run.progress[i - 1].first);
 
     // The map touch detection relies on, camera pixel -> projector pixel on the table, as the truth's.
-    const core::Calibration truth = truthRig();
+    const core::Calibration truth = test::distortedPaperLikeCalibration();
     const core::Calibration& found = *run.result.calibration;
     double worstPx = 0;
     for (double x = 60; x <= 580; x += 40)
@@ -257,7 +235,7 @@ TEST(ProjectorStep, FailsClearlyWhenNoNewPoseComesInTime) {
     holdStill(pairs, 0, 4.0);
     CalibrationOptions options;
     options.viewTimeoutS = 2.0;
-    const StepRun run = runStep(pairs, options, truthRig());
+    const StepRun run = runStep(pairs, options, test::distortedPaperLikeCalibration());
     ASSERT_FALSE(run.result.calibration);
     EXPECT_EQ(run.result.problem,
               "no pose 2 of 6 was taken within 2 s (the scene never held still with something new in view)");
