@@ -87,13 +87,6 @@ private:
     std::filesystem::path path_;
 };
 
-// The paper-like rig with a lens that bends lines by a few pixels: the truth a calibration must recover.
-core::Calibration trueRig() {
-    core::Calibration rig = test::paperLikeCalibration();
-    rig.cameraDistortion << -0.12, 0.08, 0, 0, 0;
-    return rig;
-}
-
 // A recording of the table while the projector shows the set-up board and the card's stripe lies in the
 // white border below it: 400 frames at 20 frames/s, rendered with 2 DN of sensor noise.
 class CalibrationSceneRecording {
@@ -107,7 +100,7 @@ private:
     CalibrationSceneRecording() : path_(directory_ / "scene") {
         std::filesystem::permissions(directory_.path(), std::filesystem::perms(0755));
         io::RigDescription rig = test::paperLikeRig();
-        rig.calibration = trueRig();
+        rig.calibration = test::distortedPaperLikeCalibration();
         test::SurfaceScene scene;
         scene.rig = rig.calibration;
         test::DarkRectangle stripe;
@@ -379,7 +372,7 @@ TEST_F(ServiceTest, AFailedCalibrationKeepsThePreviousOne) {
 TEST_F(ServiceTest, ATableRecordingCalibratesWithoutAProjectorOutputAndSaves) {
     // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
     // degrees under the unchanged projector-camera pair.
-    const core::Calibration truth = trueRig();
+    const core::Calibration truth = test::distortedPaperLikeCalibration();
     core::Calibration moved = truth;
     const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
                                   Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
