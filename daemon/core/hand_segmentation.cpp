@@ -1,0 +1,470 @@
+#include "core/hand_segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace everytouch::core {
+
+namespace {
+
+enum BlockClass : uchar {
+    Outside = 0,    // not on the display
+    Table = 1,      // shows the table's code
+    Unlit = 2,      // the code is too faint to tell: a shadow, black content
+    Candidate = 3,  // lit, and not the table's code
+    Hand = 4,       // a candidate in a region large enough to be a hand
+    Grown = 5,      // too faint to tell by the code, joined to the hand by its colour
+};
+
+bool isHand(uchar c) {
+    return c == Hand || c == Grown;
+}
+
+// Where in the sorted values the fraction lies (nth_element on a reused buffer).
+float quantile(std::vector<float>& values, double fraction) {
+    if (values.empty())
+        return 0.0f;
+    const auto nth = values.begin() + static_cast<long>(fraction * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), nth, values.end());
+    return *nth;
+}
+
+// How much brightness counts against colour when a pixel is matched to a side of the outline: shading
+// changes brightness across the hand and the projected content changes both sides alike, while the skin's
+// chromaticity differs from the table's wherever the light comes from.
+constexpr float kBrightnessWeight = 0.25f;
+
+// A colour as chromaticity and brightness, in levels: (r, g) / (r + g + b) scaled to 0..255, then the
+// weighted mean level. A gray camera has brightness only.
+void colourFeature(const float* bgr, int channels, float* feature) {
+    if (channels == 1) {
+        feature[0] = feature[1] = 0.0f;
+        feature[2] = bgr[0];
+        return;
+    }
+    const float sum = std::max(bgr[0] + bgr[1] + bgr[2], 1.0f);
+    feature[0] = 255.0f * bgr[2] / sum;
+    feature[1] = 255.0f * bgr[1] / sum;
+    feature[2] = kBrightnessWeight * sum / 3.0f;
+}
+
+float featureDistanceSquared(const float* a, const float* b) {
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+// Without a view beyond the projection the noise is taken as this variance of S (DN^2): a camera at its
+// default gain with some 1.4 DN of noise per frame.
+constexpr float kFallbackNoiseVariance = 4.0f;
+// How many standard deviations of chance correlation the table's expected correlation must exceed for the
+// code to tell the table from something else.
+constexpr float kSignificance = 3.0f;
+
+}  // namespace
+
+const char* toString(SegmentationMethod method) {
+    return method == SegmentationMethod::Code ? "code" : "paper";
+}
+
+std::optional<SegmentationMethod> parseSegmentationMethod(const std::string& name) {
+    if (name == "code")
+        return SegmentationMethod::Code;
+    if (name == "paper")
+        return SegmentationMethod::Paper;
+    return std::nullopt;
+}
+
+std::optional<std::string> SegmentationOptions::validate() const {
+    if (blockPx < 2)
+        return "blockPx: must be at least 2 pixels";
+    if (windowBlocks < 1 || windowBlocks % 2 == 0)
+        return "windowBlocks: must be an odd number of blocks";
+    if (!(litFraction > 0.0 && litFraction < 1.0))
+        return "litFraction: must be in (0, 1)";
+    if (!(cameraBlurPx >= 0.0) || !std::isfinite(cameraBlurPx))
+        return "cameraBlurPx: must be a non-negative number of pixels";
+    if (!(fingerWidthMm > 0.0) || !std::isfinite(fingerWidthMm))
+        return "fingerWidthMm: must be a positive number of millimetres";
+    if (closingRadiusPx < 0)
+        return "closingRadiusPx: must not be negative";
+    if (auto problem = saliency.validate())
+        return "saliency." + *problem;
+    if (auto problem = meanShift.validate())
+        return "meanShift." + *problem;
+    if (auto problem = confidence.validate())
+        return "confidence." + *problem;
+    return std::nullopt;
+}
+
+HandSegmenter::HandSegmenter(const SegmentationOptions& options) : options_(options) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("segmentation options: " + *problem);
+}
+
+void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& pattern) {
+    tableCode_ = predictTableCode(calibration, pattern, options_.cameraBlurPx);
+    evidence_ = CodeEvidence{};
+    evidence_.blockPx = options_.blockPx;
+    evidence_.windowBlocks = options_.windowBlocks;
+
+    // The display's outline in raw camera pixels, through the lens distortion.
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    const Eigen::Matrix3d displayToCamera = calibration.cameraToDisplayHomography(0.0).inverse();
+    std::vector<cv::Point> outline;
+    const double w = calibration.displaySize.width, h = calibration.displaySize.height;
+    constexpr int kSamplesPerEdge = 32;
+    const Eigen::Vector2d corners[] = {{0, 0}, {w, 0}, {w, h}, {0, h}, {0, 0}};
+    for (int edge = 0; edge < 4; ++edge)
+        for (int i = 0; i < kSamplesPerEdge; ++i) {
+            const Eigen::Vector2d d =
+                corners[edge] + (corners[edge + 1] - corners[edge]) * i / kSamplesPerEdge;
+            const Eigen::Vector2d raw = camera.distortPixel(applyHomography(displayToCamera, d));
+            outline.emplace_back(cvRound(raw.x()), cvRound(raw.y()));
+        }
+    cv::Mat display = cv::Mat::zeros(calibration.cameraSize, CV_8UC1);
+    cv::fillPoly(display, std::vector<std::vector<cv::Point>>{outline}, cv::Scalar(255));
+    displayBox_ = cv::boundingRect(display);
+
+    // A block is judged when its whole window lies on the display: a window reaching beyond the display's
+    // edge sees the code end there, which looks like something above the table.
+    const int blockPx = options_.blockPx, reach = options_.windowBlocks / 2;
+    const cv::Size blocks(calibration.cameraSize.width / blockPx, calibration.cameraSize.height / blockPx);
+    cv::Mat onDisplay(blocks, CV_8UC1);
+    for (int by = 0; by < blocks.height; ++by)
+        for (int bx = 0; bx < blocks.width; ++bx)
+            onDisplay.at<uchar>(by, bx) =
+                cv::countNonZero(display(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx))) ==
+                blockPx * blockPx;
+    displayBlocks_ = cv::Mat::zeros(blocks, CV_8UC1);
+    judgedRegion_ = cv::Mat::zeros(calibration.cameraSize, CV_8UC1);
+    for (int by = reach; by < blocks.height - reach; ++by)
+        for (int bx = reach; bx < blocks.width - reach; ++bx)
+            if (cv::countNonZero(onDisplay(cv::Rect(bx - reach, by - reach, 2 * reach + 1, 2 * reach + 1))) ==
+                (2 * reach + 1) * (2 * reach + 1)) {
+                displayBlocks_.at<uchar>(by, bx) = 1;
+                judgedRegion_(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx)).setTo(255);
+            }
+
+    const Eigen::Matrix3d cameraToTable = calibration.tableToCameraHomography(0.0).inverse();
+    const Eigen::Vector2d centre(calibration.cameraSize.width / 2.0, calibration.cameraSize.height / 2.0);
+    const double mmPerPixel = (applyHomography(cameraToTable, centre + Eigen::Vector2d(0.5, 0)) -
+                               applyHomography(cameraToTable, centre - Eigen::Vector2d(0.5, 0)))
+                                  .norm();
+    pixelsPerMm_ = 1.0 / mmPerPixel;
+}
+
+void HandSegmenter::segment(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
+    CV_Assert(texture.type() == CV_8UC3 || texture.type() == CV_8UC1);
+    if (options_.method == SegmentationMethod::Paper) {
+        segmentAsPaper(texture, mask);
+        return;
+    }
+    if (!hasRig())
+        throw std::logic_error("the code segmentation needs the rig: call setRig first");
+    CV_Assert(subtraction.size() == texture.size() && texture.size() == tableCode_.predicted.size());
+    segmentByCode(texture, subtraction, mask);
+}
+
+void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
+    measureCodeEvidence(subtraction, tableCode_, evidence_);
+    classifyBlocks();
+    keepLargeComponents();
+    mask.create(texture.size(), CV_8UC1);
+    mask.setTo(0);
+    measureBlockColours(texture);
+    growIntoFaintBlocks();
+    labelPixels(texture, subtraction, mask);
+}
+
+void HandSegmenter::classifyBlocks() {
+    const cv::Mat& correlation = evidence_.correlation;
+    const int rows = correlation.rows, cols = correlation.cols;
+    // Where the camera sees beyond the projection S holds nothing but noise: its level (which the largest
+    // of three channels' differences lifts above zero) and its variance.
+    values_.clear();
+    for (int by = 0; by < rows; ++by)
+        for (int bx = 0; bx < cols; ++bx)
+            if (std::isnan(correlation.at<float>(by, bx)))
+                values_.push_back(evidence_.meanS.at<float>(by, bx));
+    const float zeroLevel = quantile(values_, 0.5);
+    values_.clear();
+    for (int by = 0; by < rows; ++by)
+        for (int bx = 0; bx < cols; ++bx)
+            if (std::isnan(correlation.at<float>(by, bx)))
+                values_.push_back(evidence_.varianceS.at<float>(by, bx));
+    noiseVariance_ = values_.empty() ? kFallbackNoiseVariance : std::max(quantile(values_, 0.5), 0.25f);
+
+    // What the table's code would correlate with where the code's amplitude is g: S = g P + noise gives
+    // r = g sd(P) / sqrt(g^2 var(P) + noise). The camera's blur is predicted only approximately, so the
+    // table reaches a fraction of that, measured in this frame among the blocks that are clearly lit.
+    blockExpected_.create(correlation.size(), CV_32FC1);
+    values_.clear();
+    for (int by = 0; by < rows; ++by)
+        for (int bx = 0; bx < cols; ++bx) {
+            const float gain = 2.0f * std::max(0.0f, evidence_.meanS.at<float>(by, bx) - zeroLevel);
+            const float codeVariance = evidence_.varianceCode.at<float>(by, bx);
+            const float ideal =
+                gain * std::sqrt(codeVariance) / std::sqrt(gain * gain * codeVariance + noiseVariance_);
+            blockExpected_.at<float>(by, bx) = ideal;
+            const float r = correlation.at<float>(by, bx);
+            if (displayBlocks_.at<uchar>(by, bx) && !std::isnan(r) && ideal > 0.5f)
+                values_.push_back(r / ideal);
+        }
+    const float fidelity = std::clamp(quantile(values_, 0.9), 0.0f, 1.0f);
+
+    // One standard deviation of a correlation over the window when nothing correlates: neighbouring pixels
+    // share light through the blur, about two pixels per independent sample.
+    const float windowPixels = static_cast<float>(options_.blockPx * options_.blockPx *
+                                                  options_.windowBlocks * options_.windowBlocks);
+    const float chance = std::sqrt(2.0f / windowPixels);
+
+    blockClass_.create(correlation.size(), CV_8UC1);
+    values_.clear();
+    for (int by = 0; by < rows; ++by)
+        for (int bx = 0; bx < cols; ++bx) {
+            uchar& c = blockClass_.at<uchar>(by, bx);
+            const float r = correlation.at<float>(by, bx);
+            const float expected = fidelity * blockExpected_.at<float>(by, bx);
+            if (!displayBlocks_.at<uchar>(by, bx) || std::isnan(r))
+                c = Outside;
+            else if (expected < kSignificance * chance)
+                c = Unlit;  // the table's code would not stand out of the noise here either
+            else if (r >= 0.5f * expected) {
+                c = Table;
+                values_.push_back(evidence_.meanS.at<float>(by, bx));
+            } else
+                c = Candidate;
+        }
+    const float tableAmplitude = quantile(values_, 0.5);
+    litAmplitude_ = zeroLevel + static_cast<float>(options_.litFraction) * (tableAmplitude - zeroLevel);
+}
+
+void HandSegmenter::keepLargeComponents() {
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    const double blockMm = options_.blockPx / pixelsPerMm_;
+    const double fingerBlocks = options_.fingerWidthMm / blockMm;
+    const int minBlocks = std::max(2, static_cast<int>(0.5 * fingerBlocks * fingerBlocks));
+    queue_.resize(static_cast<std::size_t>(rows) * cols);
+    component_.resize(static_cast<std::size_t>(rows) * cols);
+    uchar* classes = blockClass_.ptr<uchar>();
+    for (int start = 0; start < rows * cols; ++start) {
+        if (classes[start] != Candidate)
+            continue;
+        // Flood the component (8-connected), remembering its blocks.
+        int head = 0, tail = 0, size = 0;
+        queue_[tail++] = start;
+        classes[start] = Hand;
+        while (head < tail) {
+            const int i = queue_[head++];
+            component_[size++] = i;
+            const int y = i / cols, x = i % cols;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int ny = y + dy, nx = x + dx;
+                    if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
+                        continue;
+                    const int j = ny * cols + nx;
+                    if (classes[j] == Candidate) {
+                        classes[j] = Hand;
+                        queue_[tail++] = j;
+                    }
+                }
+        }
+        if (size < minBlocks)
+            for (int k = 0; k < size; ++k)
+                classes[component_[k]] = Unlit;
+    }
+}
+
+void HandSegmenter::measureBlockColours(const cv::Mat& texture) {
+    const int blockPx = options_.blockPx, channels = texture.channels();
+    blockColour_.create(blockClass_.size(), CV_32FC3);
+    const float scale = 1.0f / static_cast<float>(blockPx * blockPx);
+    for (int by = 0; by < blockClass_.rows; ++by) {
+        cv::Vec3f* out = blockColour_.ptr<cv::Vec3f>(by);
+        for (int bx = 0; bx < blockClass_.cols; ++bx)
+            out[bx] = cv::Vec3f(0, 0, 0);
+        for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
+            const uchar* row = texture.ptr<uchar>(y);
+            for (int bx = 0; bx < blockClass_.cols; ++bx)
+                for (int x = bx * blockPx; x < (bx + 1) * blockPx; ++x)
+                    for (int c = 0; c < channels; ++c)
+                        out[bx][c] += row[x * channels + c] * scale;
+        }
+        for (int bx = 0; bx < blockClass_.cols; ++bx) {
+            const cv::Vec3f colour = out[bx];
+            colourFeature(colour.val, channels, out[bx].val);
+        }
+    }
+}
+
+void HandSegmenter::growIntoFaintBlocks() {
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    uchar* classes = blockClass_.ptr<uchar>();
+    const cv::Vec3f* colours = blockColour_.ptr<cv::Vec3f>();
+    int head = 0, tail = 0;
+    for (int i = 0; i < rows * cols; ++i)
+        if (classes[i] == Hand)
+            queue_[tail++] = i;
+    // A hand over dark content or in another part's shadow shows no code: such blocks join the hand when
+    // their colour is nearer the hand's next to them than the table's around them.
+    constexpr int kTableReach = 3;
+    while (head < tail) {
+        const int i = queue_[head++];
+        const int y = i / cols, x = i % cols;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int ny = y + dy, nx = x + dx;
+                if (ny < 0 || nx < 0 || ny >= rows || nx >= cols || classes[ny * cols + nx] != Unlit)
+                    continue;
+                const int j = ny * cols + nx;
+                const float handDistance = featureDistanceSquared(colours[j].val, colours[i].val);
+                float tableDistance = std::numeric_limits<float>::max();
+                for (int ty = std::max(ny - kTableReach, 0); ty <= std::min(ny + kTableReach, rows - 1); ++ty)
+                    for (int tx = std::max(nx - kTableReach, 0); tx <= std::min(nx + kTableReach, cols - 1);
+                         ++tx)
+                        if (classes[ty * cols + tx] == Table)
+                            tableDistance =
+                                std::min(tableDistance,
+                                         featureDistanceSquared(colours[j].val, colours[ty * cols + tx].val));
+                if (handDistance < tableDistance) {
+                    classes[j] = Grown;
+                    queue_[tail++] = j;
+                }
+            }
+    }
+}
+
+void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
+    const int rows = blockClass_.rows, cols = blockClass_.cols, blockPx = options_.blockPx;
+    const int channels = texture.channels();
+    const auto classAt = [&](int y, int x) {
+        return y < 0 || x < 0 || y >= rows || x >= cols ? uchar{Outside} : blockClass_.at<uchar>(y, x);
+    };
+    // A hand block is pure when its eight neighbours are hand too: its colour is then a clean sample of the
+    // skin. Any other block is a sample of the other side: its window shows the table's code or no code.
+    const auto pure = [&](int y, int x) {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+                if (!isHand(classAt(y + dy, x + dx)))
+                    return false;
+        return true;
+    };
+    constexpr int kReach = 3;  // blocks searched for colour samples around a block on the outline
+    for (int by = 0; by < rows; ++by)
+        for (int bx = 0; bx < cols; ++bx) {
+            const uchar c = blockClass_.at<uchar>(by, bx);
+            if (c == Outside)
+                continue;
+            bool nearHand = false;
+            for (int dy = -1; dy <= 1 && !nearHand; ++dy)
+                for (int dx = -1; dx <= 1 && !nearHand; ++dx)
+                    nearHand = isHand(classAt(by + dy, bx + dx));
+            if (!nearHand)
+                continue;
+            const cv::Rect block(bx * blockPx, by * blockPx, blockPx, blockPx);
+            if (isHand(c) && pure(by, bx)) {
+                mask(block).setTo(255);
+                continue;
+            }
+            // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
+            const float* handColours[(2 * kReach + 1) * (2 * kReach + 1)];
+            const float* otherColours[(2 * kReach + 1) * (2 * kReach + 1)];
+            int hands = 0, others = 0, looseHands = 0;
+            const float* looseHandColours[(2 * kReach + 1) * (2 * kReach + 1)];
+            for (int dy = -kReach; dy <= kReach; ++dy)
+                for (int dx = -kReach; dx <= kReach; ++dx) {
+                    const int y = by + dy, x = bx + dx;
+                    const uchar n = classAt(y, x);
+                    if (n == Outside)
+                        continue;
+                    const float* colour = blockColour_.ptr<float>(y) + 3 * x;
+                    if (isHand(n)) {
+                        looseHandColours[looseHands++] = colour;
+                        if (pure(y, x))
+                            handColours[hands++] = colour;
+                    } else {
+                        otherColours[others++] = colour;
+                    }
+                }
+            if (hands == 0) {
+                std::copy(looseHandColours, looseHandColours + looseHands, handColours);
+                hands = looseHands;
+            }
+            // A pixel in the hand's own shadow gets no light from the projector, and no code: whatever its
+            // colour, it is not the hand (a hand over black content loses its outline pixels here too).
+            constexpr int kLitReach = 2;  // the lit test averages S over 5 x 5 pixels
+            const int litSum = static_cast<int>(std::ceil(25.0f * litAmplitude_));
+            for (int y = block.y; y < block.y + blockPx; ++y) {
+                const uchar* row = texture.ptr<uchar>(y);
+                uchar* out = mask.ptr<uchar>(y);
+                for (int x = block.x; x < block.x + blockPx; ++x) {
+                    int localSum = 0;
+                    for (int dy = -kLitReach; dy <= kLitReach; ++dy) {
+                        const short* s = subtraction.ptr<short>(std::clamp(y + dy, 0, subtraction.rows - 1));
+                        for (int dx = -kLitReach; dx <= kLitReach; ++dx)
+                            localSum += s[std::clamp(x + dx, 0, subtraction.cols - 1)];
+                    }
+                    if (c != Grown && localSum < litSum) {
+                        out[x] = 0;
+                        continue;
+                    }
+                    float colour[3], pixel[3];
+                    for (int ch = 0; ch < channels; ++ch)
+                        colour[ch] = row[x * channels + ch];
+                    colourFeature(colour, channels, pixel);
+                    float nearestHand = std::numeric_limits<float>::max();
+                    float nearestOther = std::numeric_limits<float>::max();
+                    for (int k = 0; k < hands; ++k)
+                        nearestHand = std::min(nearestHand, featureDistanceSquared(pixel, handColours[k]));
+                    for (int k = 0; k < others; ++k)
+                        nearestOther = std::min(nearestOther, featureDistanceSquared(pixel, otherColours[k]));
+                    out[x] = nearestHand < nearestOther ? 255 : 0;
+                }
+            }
+        }
+}
+
+void HandSegmenter::segmentAsPaper(const cv::Mat& texture, cv::Mat& mask) {
+    const cv::Mat* colour = &texture;
+    if (texture.channels() == 1) {
+        cv::cvtColor(texture, gray3_, cv::COLOR_GRAY2BGR);
+        colour = &gray3_;
+    }
+    // The paper's camera frames the projection; ours sees the table around it too, so the method gets the
+    // display's bounding box as its image.
+    const cv::Rect whole = displayBox_.empty() ? cv::Rect(0, 0, texture.cols, texture.rows) : displayBox_;
+    computeSaliency((*colour)(whole), cv::Rect(cv::Point(), whole.size()), options_.saliency,
+                    saliencyScratch_, saliency_);
+    // The salient region: Otsu's threshold on the saliency separates the few salient colours from the many
+    // of the background; mean shift runs on their bounding box, widened by the spatial radius.
+    cv::Mat saliency8;
+    saliency_.convertTo(saliency8, CV_8U, 255.0);
+    mask.create(texture.size(), CV_8UC1);
+    mask.setTo(0);
+    cv::Mat salient;
+    cv::threshold(saliency8, salient, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+    cv::Rect roi = cv::boundingRect(salient);
+    if (roi.empty())
+        return;
+    const int margin = options_.meanShift.spatialRadius;
+    roi = cv::Rect(roi.x - margin, roi.y - margin, roi.width + 2 * margin, roi.height + 2 * margin) &
+          cv::Rect(cv::Point(), whole.size());
+    const cv::Rect inCamera = roi + whole.tl();
+    const int count = segmentMeanShift((*colour)(inCamera), options_.meanShift, meanShiftScratch_, labels_);
+    selectConfidentRegions(labels_, count, saliency_(roi), roi, whole.size(), options_.confidence,
+                           confidenceScratch_, regionMask_);
+    regionMask_.copyTo(mask(inCamera));
+    if (options_.closingRadiusPx > 0) {
+        const int side = 2 * options_.closingRadiusPx + 1;
+        cv::morphologyEx(mask, mask, cv::MORPH_CLOSE,
+                         cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(side, side)));
+    }
+}
+
+}  // namespace everytouch::core

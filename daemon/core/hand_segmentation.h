@@ -1,0 +1,121 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core/mat.hpp>
+
+#include "core/calibration.h"
+#include "core/code_evidence.h"
+#include "core/mean_shift_segmentation.h"
+#include "core/saliency.h"
+#include "core/segment_confidence.h"
+#include "core/table_code.h"
+
+namespace everytouch::core {
+
+enum class SegmentationMethod {
+    // The embedded code first: where the projector's light shows the table's code, the camera sees the table;
+    // where it lights something that does not show it, something stands above the table. Colours then place
+    // the hand's outline to the pixel. Needs the calibration and the pattern.
+    Code,
+    // The paper's method as published (section VI.A): histogram-contrast saliency, mean-shift segmentation of
+    // the salient region, the confidence fusion of eq. 12, morphological closing. Needs nothing but the
+    // image.
+    Paper,
+};
+
+const char* toString(SegmentationMethod method);
+std::optional<SegmentationMethod> parseSegmentationMethod(const std::string& name);
+
+struct SegmentationOptions {
+    SegmentationMethod method = SegmentationMethod::Code;
+
+    // The code's evidence is gathered over blocks of blockPx square pixels, each judged by the window of
+    // windowBlocks x windowBlocks blocks around it: 12 x 12 pixels hold some 100 code bits on rigs where a
+    // camera pixel sees about a projector pixel, enough to tell the table's code from another.
+    int blockPx = 4;
+    int windowBlocks = 3;
+    // A surface lit by the projector shows the code with an amplitude proportional to its albedo; below this
+    // fraction of the table's amplitude it is in a shadow or under black content, and the code says nothing.
+    double litFraction = 0.25;
+    // The camera's own blur (Gaussian sigma, camera pixels) on top of its pixels' footprint, for predicting
+    // how it sees the table's code.
+    double cameraBlurPx = 0.5;
+    // A finger is this wide (mm); a region narrower than half a finger's area is noise, not a hand.
+    double fingerWidthMm = 14.0;
+
+    // The paper's method.
+    SaliencyOptions saliency;
+    MeanShiftOptions meanShift;    // (hs, hr, M) = (7, 10, 20)
+    ConfidenceOptions confidence;  // threshold of eq. 12
+    int closingRadiusPx = 2;       // the closing that fills small holes in the hand
+
+    std::optional<std::string> validate() const;
+};
+
+// Separates the hand from the table, the projected content and the shadows in one frame pair (paper section
+// VI.A). Stateful only for its buffers and the rig's precomputed code: it has no memory of earlier frames.
+class HandSegmenter {
+public:
+    // Throws std::invalid_argument when options.validate() fails.
+    explicit HandSegmenter(const SegmentationOptions& options);
+
+    // The rig: its calibration and code (pattern CV_8UC1 0/1, projector size). The Code method needs it.
+    void setRig(const Calibration& calibration, const cv::Mat& pattern);
+    bool hasRig() const { return !tableCode_.predicted.empty(); }
+
+    // texture: T (CV_8UC3 or CV_8UC1), subtraction: S (CV_16SC1), camera size (core/code_image.h). mask:
+    // receives CV_8UC1, 255 where the camera sees a hand. After the first frames of a size, the Code method
+    // allocates nothing.
+    void segment(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
+
+    // The region of the camera image where hands are judged: the display as the camera sees it, less the
+    // half window of code at its edge (a hand elsewhere is outside what can be touched, and outside the
+    // projection there is no code). CV_8UC1, 255 inside.
+    const cv::Mat& judgedRegion() const { return judgedRegion_; }
+    // What the code said about each block in the last frame (Code method): 0 off the display, 1 the table's
+    // code, 2 too faint to tell, 3 lit but not the table's code, 4 such a block in a region large enough for
+    // a hand. CV_8UC1, block grid of blockPx.
+    const cv::Mat& blockClasses() const { return blockClass_; }
+    // Camera pixels per millimetre on the table near the image centre (from the calibration).
+    double pixelsPerMm() const { return pixelsPerMm_; }
+
+private:
+    void segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
+    void segmentAsPaper(const cv::Mat& texture, cv::Mat& mask);
+    void classifyBlocks();
+    void keepLargeComponents();
+    void measureBlockColours(const cv::Mat& texture);
+    void growIntoFaintBlocks();
+    void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
+
+    SegmentationOptions options_;
+    TableCode tableCode_;
+    cv::Mat judgedRegion_;
+    cv::Rect displayBox_;    // the display's bounding box in the camera
+    cv::Mat displayBlocks_;  // CV_8UC1, block grid: 1 where the whole window lies on the display
+    double pixelsPerMm_ = 1.0;
+    float litAmplitude_ = 0.0f;
+    float noiseVariance_ = 0.0f;  // of S where only noise is seen (DN^2)
+    cv::Mat blockExpected_;  // CV_32FC1, block grid: the table code's correlation if the table were there  //
+                             // mean S below which a surface gets too little projector light to judge
+
+    CodeEvidence evidence_;
+    cv::Mat blockClass_;   // CV_8UC1, block grid
+    cv::Mat blockColour_;  // CV_32FC3, block grid: mean texture colour
+    std::vector<float> values_;
+    std::vector<int> queue_;
+    std::vector<int> component_;
+
+    cv::Mat gray3_;
+    SaliencyScratch saliencyScratch_;
+    cv::Mat saliency_;
+    MeanShiftScratch meanShiftScratch_;
+    cv::Mat labels_;
+    ConfidenceScratch confidenceScratch_;
+    cv::Mat regionMask_;
+};
+
+}  // namespace everytouch::core
