@@ -1,4 +1,4 @@
-#include "core/fingertip_height.h"
+#include "core/surface_height.h"
 
 #include <algorithm>
 #include <cmath>
@@ -60,28 +60,29 @@ void HeightEvidence::add(const HeightEvidence& other, double weight) {
     pixels += weight * other.pixels;
 }
 
-FingertipHeight::FingertipHeight(const HeightOptions& options) : options_(options) {
+SurfaceHeight::SurfaceHeight(const HeightOptions& options) : options_(options) {
     if (auto problem = options.validate())
         throw std::invalid_argument("height options: " + *problem);
 }
 
-void FingertipHeight::setRig(const Calibration& calibration, const cv::Mat& pattern) {
+void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& pattern) {
     CV_Assert(pattern.type() == CV_8UC1 && pattern.size() == calibration.projectorSize);
     // The scales at the display's centre: a camera pixel's footprint and a millimetre, in projector pixels.
     const Eigen::Matrix3d tableToProjector = calibration.tableToProjectorHomography(0.0);
-    const Eigen::Vector2d centreMm = applyHomography(calibration.displayToTableHomography(),
-                                                     Eigen::Vector2d(calibration.displaySize.width / 2.0,
-                                                                     calibration.displaySize.height / 2.0));
-    const double projectorPixelsPerMm = (applyHomography(tableToProjector, centreMm + Eigen::Vector2d(0.5, 0)) -
-                                         applyHomography(tableToProjector, centreMm - Eigen::Vector2d(0.5, 0)))
-                                            .norm();
+    const Eigen::Vector2d centreMm = applyHomography(
+        calibration.displayToTableHomography(),
+        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const double projectorPixelsPerMm =
+        (applyHomography(tableToProjector, centreMm + Eigen::Vector2d(0.5, 0)) -
+         applyHomography(tableToProjector, centreMm - Eigen::Vector2d(0.5, 0)))
+            .norm();
     const Eigen::Matrix3d cameraToProjector = calibration.cameraToProjectorHomography(0.0);
     const Eigen::Vector2d centrePx = applyHomography(calibration.tableToCameraHomography(0.0), centreMm);
-    const double footprint =
-        (applyHomography(cameraToProjector, centrePx + Eigen::Vector2d(1, 0)) -
-         applyHomography(cameraToProjector, centrePx))
-            .norm();
-    const double sigma = std::hypot(kBoxSigmaPerWidth * footprint, options_.skinScatterMm * projectorPixelsPerMm);
+    const double footprint = (applyHomography(cameraToProjector, centrePx + Eigen::Vector2d(1, 0)) -
+                              applyHomography(cameraToProjector, centrePx))
+                                 .norm();
+    const double sigma =
+        std::hypot(kBoxSigmaPerWidth * footprint, options_.skinScatterMm * projectorPixelsPerMm);
     pattern.convertTo(panel_, CV_32FC1);
     cv::GaussianBlur(panel_, panel_, cv::Size(), sigma);
 
@@ -94,44 +95,58 @@ void FingertipHeight::setRig(const Calibration& calibration, const cv::Mat& patt
     for (int y = 0; y < undistorted_.rows; ++y)
         for (int x = 0; x < undistorted_.cols; ++x) {
             const Eigen::Vector2d u = camera.undistortPixel(Eigen::Vector2d(x, y));
-            undistorted_.at<cv::Vec2f>(y, x) = cv::Vec2f(static_cast<float>(u.x()), static_cast<float>(u.y()));
+            undistorted_.at<cv::Vec2f>(y, x) =
+                cv::Vec2f(static_cast<float>(u.x()), static_cast<float>(u.y()));
         }
 }
 
-void FingertipHeight::measure(const cv::Mat& subtraction, const cv::Mat& handMask, const Eigen::Vector2d& tip,
-                              const Eigen::Vector2d& direction, double widthPx, HeightEvidence& evidence) {
+void SurfaceHeight::clearPixels() {
+    values_.clear();
+    points_.clear();
+}
+
+void SurfaceHeight::addPixel(const cv::Mat& subtraction, int x, int y) {
+    values_.push_back(subtraction.at<short>(y, x));
+    const cv::Vec2f& u = undistorted_.at<cv::Vec2f>(y, x);
+    points_.emplace_back(u[0], u[1]);
+}
+
+void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask,
+                                     const Eigen::Vector2d& tip, const Eigen::Vector2d& direction,
+                                     double widthPx, HeightEvidence& evidence) {
     CV_Assert(subtraction.type() == CV_16SC1 && handMask.type() == CV_8UC1);
-    evidence.clear(homographies_.size());
     // The round end of a finger seen from above: its middle lies half a width behind the silhouette's tip.
     const Eigen::Vector2d centre = tip - 0.5 * widthPx * direction;
     const double radius = options_.regionWidths * widthPx;
-    const int x0 = std::max(0, static_cast<int>(std::floor(centre.x() - radius)));
-    const int x1 = std::min(subtraction.cols - 1, static_cast<int>(std::ceil(centre.x() + radius)));
-    const int y0 = std::max(0, static_cast<int>(std::floor(centre.y() - radius)));
-    const int y1 = std::min(subtraction.rows - 1, static_cast<int>(std::ceil(centre.y() + radius)));
-    values_.clear();
-    points_.clear();
-    double sum = 0.0;
+    const int x0 = std::max(1, static_cast<int>(std::floor(centre.x() - radius)));
+    const int x1 = std::min(subtraction.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));
+    const int y0 = std::max(1, static_cast<int>(std::floor(centre.y() - radius)));
+    const int y1 = std::min(subtraction.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
+    clearPixels();
     for (int y = y0; y <= y1; ++y) {
-        const short* s = subtraction.ptr<short>(y);
+        const uchar* above = handMask.ptr<uchar>(y - 1);
         const uchar* m = handMask.ptr<uchar>(y);
-        // Only pixels whose neighbours are hand too: a pixel on the outline sees some table, whose sharp code
-        // would outweigh the skin's blurred one.
-        const uchar* above = handMask.ptr<uchar>(std::max(y - 1, 0));
-        const uchar* below = handMask.ptr<uchar>(std::min(y + 1, handMask.rows - 1));
-        const cv::Vec2f* u = undistorted_.ptr<cv::Vec2f>(y);
+        const uchar* below = handMask.ptr<uchar>(y + 1);
         for (int x = x0; x <= x1; ++x) {
-            if (!m[x] || !above[x] || !below[x] || !m[std::max(x - 1, 0)] || !m[std::min(x + 1, handMask.cols - 1)] ||
+            // Only pixels whose neighbours are hand too: a pixel on the outline sees some table, whose sharp
+            // code would outweigh the skin's blurred one.
+            if (!m[x] || !above[x] || !below[x] || !m[x - 1] || !m[x + 1] ||
                 (x - centre.x()) * (x - centre.x()) + (y - centre.y()) * (y - centre.y()) > radius * radius)
                 continue;
-            values_.push_back(s[x]);
-            points_.emplace_back(u[x][0], u[x][1]);
-            sum += s[x];
+            addPixel(subtraction, x, y);
         }
     }
+    measurePixels(evidence);
+}
+
+void SurfaceHeight::measurePixels(HeightEvidence& evidence) const {
+    evidence.clear(homographies_.size());
     const std::size_t n = values_.size();
     if (n < 8)
         return;
+    double sum = 0.0;
+    for (float v : values_)
+        sum += v;
     const double meanS = sum / static_cast<double>(n);
     double varianceS = 0.0;
     for (float v : values_)
@@ -145,7 +160,8 @@ void FingertipHeight::measure(const cv::Mat& subtraction, const cv::Mat& handMas
             const double px = H(0, 0) * points_[i].x + H(0, 1) * points_[i].y + H(0, 2);
             const double py = H(1, 0) * points_[i].x + H(1, 1) * points_[i].y + H(1, 2);
             const double pw = H(2, 0) * points_[i].x + H(2, 1) * points_[i].y + H(2, 2);
-            const float p = std::max(0.0f, sample(panel_, static_cast<float>(px / pw), static_cast<float>(py / pw)));
+            const float p =
+                std::max(0.0f, sample(panel_, static_cast<float>(px / pw), static_cast<float>(py / pw)));
             sumP += p;
             sumPP += p * p;
             sumSP += (values_[i] - meanS) * p;
@@ -155,7 +171,7 @@ void FingertipHeight::measure(const cv::Mat& subtraction, const cv::Mat& handMas
     }
 }
 
-HeightEstimate FingertipHeight::estimate(const HeightEvidence& evidence) const {
+HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     HeightEstimate result;
     const std::size_t count = evidence.covariance.size();
     if (count == 0 || evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)

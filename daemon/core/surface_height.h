@@ -50,10 +50,10 @@ struct HeightEstimate {
     double uncertaintyMm = 0.0;  // one standard deviation
 };
 
-class FingertipHeight {
+class SurfaceHeight {
 public:
     // Throws std::invalid_argument when options.validate() fails.
-    explicit FingertipHeight(const HeightOptions& options);
+    explicit SurfaceHeight(const HeightOptions& options);
 
     // pattern: CV_8UC1 0/1, projector size.
     void setRig(const Calibration& calibration, const cv::Mat& pattern);
@@ -63,19 +63,25 @@ public:
 
     // Gathers the evidence of one frame around a fingertip (camera pixels, raw) of `widthPx` whose finger
     // points along `direction`: subtraction S (CV_16SC1), hand mask (CV_8UC1). No allocation once sized.
-    void measure(const cv::Mat& subtraction, const cv::Mat& handMask, const Eigen::Vector2d& tip,
-                 const Eigen::Vector2d& direction, double widthPx, HeightEvidence& evidence);
+    void measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask, const Eigen::Vector2d& tip,
+                          const Eigen::Vector2d& direction, double widthPx, HeightEvidence& evidence);
+
+    // The evidence of the pixels added since clear(): for any surface, e.g. a region that might be a hand.
+    void clearPixels();
+    void addPixel(const cv::Mat& subtraction, int x, int y);
+    std::size_t pixelCount() const { return values_.size(); }
+    void measurePixels(HeightEvidence& evidence) const;
 
     // The height the evidence supports best.
     HeightEstimate estimate(const HeightEvidence& evidence) const;
 
 private:
     HeightOptions options_;
-    cv::Mat panel_;          // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
-    cv::Mat undistorted_;    // CV_32FC2, camera size: each raw pixel's undistorted position
+    cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
+    cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
     std::vector<Eigen::Matrix3d> homographies_;  // undistorted camera -> projector, per candidate height
-    std::vector<float> values_;                 // S at the region's pixels
-    std::vector<cv::Point2f> points_;           // the region's undistorted pixels
+    std::vector<float> values_;                  // S at the region's pixels
+    std::vector<cv::Point2f> points_;            // the region's undistorted pixels
 };
 
 }  // namespace everytouch::core
