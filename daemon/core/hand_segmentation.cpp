@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera_model.h"
+#include "core/fill.h"
 #include "core/geometry.h"
 
 namespace everytouch::core {
@@ -120,6 +122,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     evidence_ = CodeEvidence{};
     evidence_.blockPx = options_.blockPx;
     evidence_.windowBlocks = options_.windowBlocks;
+    evidence_.wideWindowBlocks = options_.windowBlocks + 2;
 
     // The display's outline in raw camera pixels, through the lens distortion.
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
@@ -150,6 +153,11 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
                 cv::countNonZero(display(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx))) ==
                 blockPx * blockPx;
     displayBlocks_ = cv::Mat::zeros(blocks, CV_8UC1);
+    // The per-frame buffers at their largest, so that no frame allocates.
+    const std::size_t blockCount = static_cast<std::size_t>(blocks.area());
+    values_.reserve(blockCount);
+    queue_.resize(blockCount);
+    component_.resize(blockCount);
     judgedRegion_ = cv::Mat::zeros(calibration.cameraSize, CV_8UC1);
     for (int by = reach; by < blocks.height - reach; ++by)
         for (int bx = reach; bx < blocks.width - reach; ++bx)
@@ -184,79 +192,99 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     classifyBlocks();
     keepHandComponents(subtraction);
     mask.create(texture.size(), CV_8UC1);
-    mask.setTo(0);
-    measureBlockColours(texture);
-    growIntoFaintBlocks();
+    fill(mask, 0);
+    // Colours matter only around the hand; they are measured when first looked at.
+    blockColour_.create(blockClass_.size(), CV_32FC3);
+    colourKnown_.create(blockClass_.size(), CV_8UC1);
+    fill(colourKnown_, 0);
+    growIntoFaintBlocks(texture);
     labelPixels(texture, subtraction, mask);
 }
 
 void HandSegmenter::classifyBlocks() {
-    const cv::Mat& correlation = evidence_.correlation;
-    const int rows = correlation.rows, cols = correlation.cols;
+    const CodeEvidence::Window& narrow = evidence_.narrow;
+    const CodeEvidence::Window& wide = evidence_.wide;
+    const int rows = narrow.correlation.rows, cols = narrow.correlation.cols;
     // Where the camera sees beyond the projection S holds nothing but noise: its level (which the largest
     // of three channels' differences lifts above zero) and its variance.
     values_.clear();
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx)
-            if (std::isnan(correlation.at<float>(by, bx)))
-                values_.push_back(evidence_.meanS.at<float>(by, bx));
+            if (std::isnan(narrow.correlation.at<float>(by, bx)))
+                values_.push_back(narrow.meanS.at<float>(by, bx));
     const float zeroLevel = quantile(values_, 0.5);
     values_.clear();
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx)
-            if (std::isnan(correlation.at<float>(by, bx)))
-                values_.push_back(evidence_.varianceS.at<float>(by, bx));
+            if (std::isnan(narrow.correlation.at<float>(by, bx)))
+                values_.push_back(narrow.varianceS.at<float>(by, bx));
     noiseVariance_ = values_.empty() ? kFallbackNoiseVariance : std::max(quantile(values_, 0.5), 0.25f);
 
     // What the table's code would correlate with where the code's amplitude is g: S = g P + noise gives
     // r = g sd(P) / sqrt(g^2 var(P) + noise). The camera's blur is predicted only approximately, so the
     // table reaches a fraction of that, measured in this frame among the blocks that are clearly lit.
-    blockExpected_.create(correlation.size(), CV_32FC1);
+    const auto ideal = [&](const CodeEvidence::Window& window, int by, int bx) {
+        const float gain = 2.0f * std::max(0.0f, window.meanS.at<float>(by, bx) - zeroLevel);
+        const float codeVariance = window.varianceCode.at<float>(by, bx);
+        return gain * std::sqrt(codeVariance) / std::sqrt(gain * gain * codeVariance + noiseVariance_);
+    };
     values_.clear();
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx) {
-            const float gain = 2.0f * std::max(0.0f, evidence_.meanS.at<float>(by, bx) - zeroLevel);
-            const float codeVariance = evidence_.varianceCode.at<float>(by, bx);
-            const float ideal =
-                gain * std::sqrt(codeVariance) / std::sqrt(gain * gain * codeVariance + noiseVariance_);
-            blockExpected_.at<float>(by, bx) = ideal;
-            const float r = correlation.at<float>(by, bx);
-            if (displayBlocks_.at<uchar>(by, bx) && !std::isnan(r) && ideal > 0.5f)
-                values_.push_back(r / ideal);
+            const float r = narrow.correlation.at<float>(by, bx);
+            const float expected = ideal(narrow, by, bx);
+            if (displayBlocks_.at<uchar>(by, bx) && !std::isnan(r) && expected > 0.5f)
+                values_.push_back(r / expected);
         }
     const float fidelity = std::clamp(quantile(values_, 0.9), 0.0f, 1.0f);
 
-    // One standard deviation of a correlation over the window when nothing correlates: neighbouring pixels
+    // One standard deviation of a correlation over a window when nothing correlates: neighbouring pixels
     // share light through the blur, about two pixels per independent sample.
-    const float windowPixels = static_cast<float>(options_.blockPx * options_.blockPx *
-                                                  options_.windowBlocks * options_.windowBlocks);
-    const float chance = std::sqrt(2.0f / windowPixels);
+    const auto chance = [](const CodeEvidence::Window& window) {
+        return std::sqrt(2.0f / static_cast<float>(window.pixels));
+    };
+    const float narrowChance = chance(narrow), wideChance = chance(wide);
 
-    blockClass_.create(correlation.size(), CV_8UC1);
+    blockClass_.create(narrow.correlation.size(), CV_8UC1);
     values_.clear();
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx) {
             uchar& c = blockClass_.at<uchar>(by, bx);
-            const float r = correlation.at<float>(by, bx);
-            const float expected = fidelity * blockExpected_.at<float>(by, bx);
-            if (!displayBlocks_.at<uchar>(by, bx) || std::isnan(r))
+            if (!displayBlocks_.at<uchar>(by, bx) || std::isnan(narrow.correlation.at<float>(by, bx))) {
                 c = Outside;
-            else if (expected < kSignificance * chance)
-                c = Unlit;  // the table's code would not stand out of the noise here either
-            else if (r >= 0.5f * expected) {
+                continue;
+            }
+            // The narrow window where the code is strong enough there; the wide one where it is faint.
+            const CodeEvidence::Window* window = &narrow;
+            float expected = fidelity * ideal(narrow, by, bx);
+            if (expected < kSignificance * narrowChance && !std::isnan(wide.correlation.at<float>(by, bx))) {
+                window = &wide;
+                expected = fidelity * ideal(wide, by, bx);
+                if (expected < kSignificance * wideChance) {
+                    c = Unlit;  // the table's code would not stand out of the noise here either
+                    continue;
+                }
+            } else if (expected < kSignificance * narrowChance) {
+                c = Unlit;
+                continue;
+            }
+            if (window->correlation.at<float>(by, bx) >= 0.5f * expected) {
                 c = Table;
-                values_.push_back(evidence_.meanS.at<float>(by, bx));
-            } else
+                values_.push_back(narrow.meanS.at<float>(by, bx));
+            } else {
                 c = Candidate;
+            }
         }
     const float tableAmplitude = quantile(values_, 0.5);
     tableAmplitude_ = tableAmplitude;
-    litAmplitude_ = zeroLevel + static_cast<float>(options_.litFraction) * (tableAmplitude - zeroLevel);
+    // A pixel gets no projector light at all (a shadow) when the mean of S around it stays within the noise
+    // of the level where nothing is lit: three standard deviations of a 3 x 3 mean.
+    litAmplitude_ = zeroLevel + std::sqrt(noiseVariance_);
 }
 
 bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
     // The component's pixels, at most about kMaxPixels of them (a sample of its blocks).
-    constexpr int kMaxPixels = 1600;
+    constexpr int kMaxPixels = 800;
     const int blockPx = options_.blockPx, cols = blockClass_.cols;
     const int perBlock = blockPx * blockPx;
     const int blockStride = std::max(1, size * perBlock / kMaxPixels);
@@ -267,7 +295,10 @@ bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
             for (int x = x0; x < x0 + blockPx; ++x)
                 elevation_.addPixel(subtraction, x, y);
     }
-    elevation_.measurePixels(elevationEvidence_);
+    // Heights a few millimetres apart: the table and a hand lie ten or more apart.
+    const std::size_t stride = std::max<std::size_t>(
+        1, static_cast<std::size_t>(std::floor(0.5 * options_.minElevationMm / options_.elevation.stepMm)));
+    elevation_.measurePixels(elevationEvidence_, stride);
     const HeightEstimate height = elevation_.estimate(elevationEvidence_);
     return height.valid && height.heightMm < options_.minElevationMm;
 }
@@ -309,32 +340,28 @@ void HandSegmenter::keepHandComponents(const cv::Mat& subtraction) {
     }
 }
 
-void HandSegmenter::measureBlockColours(const cv::Mat& texture) {
+const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx) {
+    cv::Vec3f& feature = blockColour_.at<cv::Vec3f>(by, bx);
+    uchar& known = colourKnown_.at<uchar>(by, bx);
+    if (known)
+        return feature.val;
     const int blockPx = options_.blockPx, channels = texture.channels();
-    blockColour_.create(blockClass_.size(), CV_32FC3);
     const float scale = 1.0f / static_cast<float>(blockPx * blockPx);
-    for (int by = 0; by < blockClass_.rows; ++by) {
-        cv::Vec3f* out = blockColour_.ptr<cv::Vec3f>(by);
-        for (int bx = 0; bx < blockClass_.cols; ++bx)
-            out[bx] = cv::Vec3f(0, 0, 0);
-        for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
-            const uchar* row = texture.ptr<uchar>(y);
-            for (int bx = 0; bx < blockClass_.cols; ++bx)
-                for (int x = bx * blockPx; x < (bx + 1) * blockPx; ++x)
-                    for (int c = 0; c < channels; ++c)
-                        out[bx][c] += row[x * channels + c] * scale;
-        }
-        for (int bx = 0; bx < blockClass_.cols; ++bx) {
-            const cv::Vec3f colour = out[bx];
-            colourFeature(colour.val, channels, out[bx].val);
-        }
+    float colour[3] = {0.0f, 0.0f, 0.0f};
+    for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
+        const uchar* row = texture.ptr<uchar>(y) + bx * blockPx * channels;
+        for (int x = 0; x < blockPx; ++x)
+            for (int c = 0; c < channels; ++c)
+                colour[c] += row[x * channels + c] * scale;
     }
+    colourFeature(colour, channels, feature.val);
+    known = 1;
+    return feature.val;
 }
 
-void HandSegmenter::growIntoFaintBlocks() {
+void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     uchar* classes = blockClass_.ptr<uchar>();
-    const cv::Vec3f* colours = blockColour_.ptr<cv::Vec3f>();
     int head = 0, tail = 0;
     for (int i = 0; i < rows * cols; ++i)
         if (classes[i] == Hand)
@@ -351,15 +378,15 @@ void HandSegmenter::growIntoFaintBlocks() {
                 if (ny < 0 || nx < 0 || ny >= rows || nx >= cols || classes[ny * cols + nx] != Unlit)
                     continue;
                 const int j = ny * cols + nx;
-                const float handDistance = featureDistanceSquared(colours[j].val, colours[i].val);
+                const float* colour = blockFeature(texture, ny, nx);
+                const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
                 float tableDistance = std::numeric_limits<float>::max();
                 for (int ty = std::max(ny - kTableReach, 0); ty <= std::min(ny + kTableReach, rows - 1); ++ty)
                     for (int tx = std::max(nx - kTableReach, 0); tx <= std::min(nx + kTableReach, cols - 1);
                          ++tx)
                         if (classes[ty * cols + tx] == Table)
-                            tableDistance =
-                                std::min(tableDistance,
-                                         featureDistanceSquared(colours[j].val, colours[ty * cols + tx].val));
+                            tableDistance = std::min(
+                                tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
                 if (handDistance < tableDistance) {
                     classes[j] = Grown;
                     queue_[tail++] = j;
@@ -376,9 +403,12 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
     };
     // A hand block is pure when its eight neighbours are hand too: its colour is then a clean sample of the
     // skin. Any other block is a sample of the other side: its window shows the table's code or no code.
-    const auto pure = [&](int y, int x) {
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx)
+    // A window reaching over the outline makes blocks up to a window's half beyond it look like hand, so a
+    // clean sample of skin lies that far inside the region of hand blocks.
+    const int depth = options_.windowBlocks / 2 + 1;
+    const auto pure = [&](int y, int x, int reach) {
+        for (int dy = -reach; dy <= reach; ++dy)
+            for (int dx = -reach; dx <= reach; ++dx)
                 if (!isHand(classAt(y + dy, x + dx)))
                     return false;
         return true;
@@ -396,8 +426,8 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             if (!nearHand)
                 continue;
             const cv::Rect block(bx * blockPx, by * blockPx, blockPx, blockPx);
-            if (isHand(c) && pure(by, bx)) {
-                mask(block).setTo(255);
+            if (isHand(c) && pure(by, bx, depth)) {
+                fill(mask(block), 255);
                 continue;
             }
             // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
@@ -411,10 +441,10 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     const uchar n = classAt(y, x);
                     if (n == Outside)
                         continue;
-                    const float* colour = blockColour_.ptr<float>(y) + 3 * x;
+                    const float* colour = blockFeature(texture, y, x);
                     if (isHand(n)) {
                         looseHandColours[looseHands++] = colour;
-                        if (pure(y, x))
+                        if (pure(y, x, depth))
                             handColours[hands++] = colour;
                     } else {
                         otherColours[others++] = colour;

@@ -94,8 +94,9 @@ private:
     void classifyBlocks();
     void keepHandComponents(const cv::Mat& subtraction);
     bool liesOnTable(const cv::Mat& subtraction, int size);
-    void measureBlockColours(const cv::Mat& texture);
-    void growIntoFaintBlocks();
+    // A block's mean colour as colourFeature makes it, measured on first use in a frame.
+    const float* blockFeature(const cv::Mat& texture, int by, int bx);
+    void growIntoFaintBlocks(const cv::Mat& texture);
     void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
     SegmentationOptions options_;
@@ -112,7 +113,8 @@ private:
 
     CodeEvidence evidence_;
     cv::Mat blockClass_;   // CV_8UC1, block grid
-    cv::Mat blockColour_;  // CV_32FC3, block grid: mean texture colour
+    cv::Mat blockColour_;  // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
+    cv::Mat colourKnown_;  // CV_8UC1, block grid: 1 where the colour has been measured this frame
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;

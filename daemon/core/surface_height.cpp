@@ -90,6 +90,11 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     for (double d = 0.0; d <= options_.maxHeightMm + 1e-9; d += options_.stepMm)
         homographies_.push_back(calibration.cameraToProjectorHomography(d));
 
+    // Regions are a fingertip or a sample of a hand: this many pixels at most, in practice.
+    constexpr std::size_t kTypicalMostPixels = 8192;
+    values_.reserve(kTypicalMostPixels);
+    points_.reserve(kTypicalMostPixels);
+
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     undistorted_.create(calibration.cameraSize, CV_32FC2);
     for (int y = 0; y < undistorted_.rows; ++y)
@@ -139,7 +144,7 @@ void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& 
     measurePixels(evidence);
 }
 
-void SurfaceHeight::measurePixels(HeightEvidence& evidence) const {
+void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) const {
     evidence.clear(homographies_.size());
     const std::size_t n = values_.size();
     if (n < 8)
@@ -153,7 +158,7 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence) const {
         varianceS += (v - meanS) * (v - meanS);
     evidence.subtractionVariance = varianceS;
     evidence.pixels = static_cast<double>(n);
-    for (std::size_t h = 0; h < homographies_.size(); ++h) {
+    for (std::size_t h = 0; h < homographies_.size(); h += stride) {
         const Eigen::Matrix3d& H = homographies_[h];
         double sumP = 0.0, sumPP = 0.0, sumSP = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
@@ -183,7 +188,7 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
         return denominator > 0.0 ? evidence.covariance[h] / denominator : 0.0;
     };
     for (std::size_t h = 0; h < count; ++h)
-        if (const double r = correlationAt(h); r > bestCorrelation) {
+        if (const double r = correlationAt(h); evidence.codeVariance[h] > 0.0 && r > bestCorrelation) {
             bestCorrelation = r;
             best = h;
         }
@@ -195,7 +200,8 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
         return result;
     // The peak to a fraction of a step: the parabola through the best height and its neighbours.
     double offset = 0.0;
-    if (best > 0 && best + 1 < count) {
+    if (best > 0 && best + 1 < count && evidence.codeVariance[best - 1] > 0.0 &&
+        evidence.codeVariance[best + 1] > 0.0) {
         const double a = correlationAt(best - 1), b = bestCorrelation, c = correlationAt(best + 1);
         const double curvature = a - 2 * b + c;
         if (curvature < 0.0)

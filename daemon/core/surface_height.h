@@ -70,7 +70,9 @@ public:
     void clearPixels();
     void addPixel(const cv::Mat& subtraction, int x, int y);
     std::size_t pixelCount() const { return values_.size(); }
-    void measurePixels(HeightEvidence& evidence) const;
+    // Every `stride`-th candidate height only (the others get no evidence): a coarse look is enough to tell
+    // the table from something well above it.
+    void measurePixels(HeightEvidence& evidence, std::size_t stride = 1) const;
 
     // The height the evidence supports best.
     HeightEstimate estimate(const HeightEvidence& evidence) const;

@@ -41,9 +41,13 @@ std::optional<std::vector<core::FramePair>> CalibrationRunner::capture(std::size
         std::optional<std::vector<core::FramePair>> pairs;
     };
     auto handover = std::make_shared<Handover>();
-    const FrameTap::Ticket ticket = tap_.request(pairs, [handover](std::vector<core::FramePair>&& captured) {
+    const FrameTap::Ticket ticket = tap_.request(pairs, [handover](std::vector<TappedPair>&& captured) {
+        std::vector<core::FramePair> framePairs;
+        framePairs.reserve(captured.size());
+        for (TappedPair& tapped : captured)
+            framePairs.push_back(std::move(tapped.pair));
         std::lock_guard lock(handover->mutex);
-        handover->pairs = std::move(captured);
+        handover->pairs = std::move(framePairs);
         handover->arrived.notify_all();
     });
     const auto deadline = Clock::now() + captureTimeout(pairs);

@@ -93,6 +93,8 @@ int Daemon::run() {
     ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe()
                  << (projector_ ? ", calibration images on " + projector_->describe() : std::string());
     const std::optional<io::RigDescription> rig = source_->rig();
+    if (rig)
+        pattern_ = rig->pattern;
     if (projector_)
         projectorSize_ = projector_->size();
     else if (rig)
@@ -183,10 +185,11 @@ void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
     loopOptions.queueCapacity = kQueueFrames;
     // Sim and replay running fast can wait for the pipeline; a paced stream behaves like a camera.
     loopOptions.overflow = options_.fast ? FrameQueue::Overflow::Block : FrameQueue::Overflow::DropOldest;
+    pipeline_ = std::make_unique<core::TouchPipeline>();
     loop_ = std::make_unique<FrameLoop>(
-        *source_, std::move(sinks), recorder_.get(), loopOptions,
-        PipelineSettings{store_->active(), touchHeightMm_}, [this] { inbox_.post([this] { onLoopNews(); }); },
-        [this](const PipelineSettings& settings) {
+        *source_, *pipeline_, std::move(sinks), recorder_.get(), loopOptions, pipelineSettings(),
+        [this] { inbox_.post([this] { onLoopNews(); }); },
+        [this](const core::PipelineSettings& settings) {
             if (!touchscreen_ || !settings.calibration)
                 return;
             try {
@@ -196,9 +199,8 @@ void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
             }
         });
     snapshots_ = std::make_unique<SnapshotRequests>(
-        event_.get(), *loop_, inbox_, [this](SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
-            std::uint64_t contactsVersion = 0;
-            renderSnapshot(kind, pair, store_->active(), loop_->contacts(contactsVersion), image);
+        event_.get(), *loop_, inbox_, [this](SnapshotKind kind, const TappedPair& tapped, cv::Mat& image) {
+            renderSnapshot(kind, tapped.pair, tapped.detection.get(), store_->active(), image);
         });
     loop_->start();
 }
@@ -264,9 +266,13 @@ DaemonState Daemon::state() const {
         return DaemonState::Failed;
     if (calibration_)
         return DaemonState::Calibrating;
-    if (!calibrated())
+    if (!calibrated() || !loop_ || !loop_->detecting())
         return DaemonState::Degraded;
     return DaemonState::Running;
+}
+
+core::PipelineSettings Daemon::pipelineSettings() const {
+    return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_};
 }
 
 LoopStatistics Daemon::statistics() const {
@@ -301,7 +307,9 @@ void Daemon::notifyStatus() {
         case DaemonState::Running:
         case DaemonState::Degraded: {
             const LoopStatistics statistics = loop_->statistics();
-            status = (calibrated() ? "Running on " : "Not calibrated (run everytouch-calib calibrate), on ") +
+            status = (!calibrated()        ? "Not calibrated (run everytouch-calib calibrate), on "
+                      : loop_->detecting() ? "Running on "
+                                           : "Not detecting (" + loop_->idleReason() + "), on ") +
                      rigName_ + ": " + formatDouble("%.1f", statistics.frameRate) + " frames/s, " +
                      std::to_string(statistics.dropped) + " dropped";
             break;
@@ -318,7 +326,7 @@ void Daemon::notifyStatus() {
 
 void Daemon::applySettings() {
     if (loop_)
-        loop_->setSettings(PipelineSettings{store_->active(), touchHeightMm_});
+        loop_->setSettings(pipelineSettings());
 }
 
 void Daemon::onLoopNews() {
@@ -331,6 +339,7 @@ void Daemon::onLoopNews() {
         sd_event_exit(event_.get(), exitStatus_);
         return;
     }
+    refreshState();  // detection may have started or stopped
     emitContacts();
 }
 
@@ -472,14 +481,9 @@ void Daemon::reloadConfig() {
 
 void Daemon::snapshot(sd_bus_message* call, std::string_view what, int fd) {
     const std::optional<SnapshotKind> kind = parseSnapshotKind(what);
-    if (!kind && snapshotNeedsDetection(what))
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS,
-                       "Snapshot \"" + std::string(what) +
-                           "\" is not available yet: the hand segmentation is not part of this build");
     if (!kind)
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Unknown snapshot \"" + std::string(what) +
-                                                      "\"; expected " + kSnapshotKinds + " (later also " +
-                                                      kSnapshotKindsNeedingDetection + ")");
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS,
+                       "Unknown snapshot \"" + std::string(what) + "\"; expected " + kSnapshotKinds);
     // Either answer may come after this call returned, so both keep the call alive.
     const std::shared_ptr<sd_bus_message> held(sd_bus_message_ref(call), sd_bus_message_unref);
     snapshots_->add(*kind, fd,
@@ -505,8 +509,12 @@ void Daemon::shutDown() {
     ET_LOG(Info) << "processed " << statistics.frames << " frames (" << statistics.pairs << " pairs) in "
                  << formatDouble("%.2f", statistics.seconds) << " s, " << statistics.dropped
                  << " dropped; all contacts released";
-    ET_LOG(Notice) << "touch detection is not part of this build yet: frames are paired and recorded, no "
-                      "contacts are reported";
+    ET_LOG(Info) << "detection took " << formatDouble("%.2f", statistics.pipelineMedianMs)
+                 << " ms per pair (median), " << formatDouble("%.2f", statistics.pipelineP99Ms)
+                 << " ms (99th percentile)"
+                 << (statistics.pipelineFailures
+                         ? ", failed on " + std::to_string(statistics.pipelineFailures) + " pairs"
+                         : std::string());
     snapshots_.reset();
     loop_.reset();
 }

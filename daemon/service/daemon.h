@@ -39,9 +39,9 @@ inline constexpr int kExitNotConfigured = 6;  // a service without a camera (LSB
 
 enum class DaemonState {
     Starting,     // until the frames flow
-    Running,      // calibrated, detecting touches
+    Running,      // calibrated and detecting touches
     Calibrating,  // a Calibrate job runs
-    Degraded,     // running without a usable calibration: no touches
+    Degraded,     // running without detecting: no usable calibration, no known code, or a failing stage
     Failed,       // the camera or the pipeline failed; the daemon is about to exit
 };
 const char* toString(DaemonState state);
@@ -92,6 +92,7 @@ private:
     void emitContacts();
     void finishCalibration(const CalibrationOutcome& outcome);
     void applySettings();
+    core::PipelineSettings pipelineSettings() const;
     void refreshState();
     void notifyStatus();
     void shutDown();
@@ -126,6 +127,8 @@ private:
     std::vector<io::EventSource> eventSources_;
     io::EventSource contactsTimer_;
     std::unique_ptr<BusService> bus_;
+    cv::Mat pattern_;  // the code the rig projects; empty when the rig does not say
+    std::unique_ptr<core::PairPipeline> pipeline_;
     std::unique_ptr<FrameLoop> loop_;
     std::unique_ptr<CalibrationRunner> calibration_;  // while a Calibrate job runs
     std::unique_ptr<SnapshotRequests> snapshots_;

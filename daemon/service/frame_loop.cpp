@@ -1,7 +1,10 @@
 #include "service/frame_loop.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
+
+#include "io/log.h"
 
 namespace everytouch::service {
 
@@ -14,6 +17,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kSmoothingSeconds = 1.0;
 // The pipeline thread wakes at least this often, so its heartbeat shows it is alive while no frame comes.
 constexpr std::chrono::milliseconds kPipelineWake{100};
+// Pipeline times kept for the median and the 99th percentile: a minute at 120 Hz.
+constexpr std::size_t kPipelineSamples = 8192;
 
 // The weight of one new sample when samples come at `perSecond`, so that a second's worth of them counts
 // as much as everything before.
@@ -23,17 +28,19 @@ double smoothingWeight(double perSecond) {
 
 }  // namespace
 
-FrameLoop::FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks,
-                     io::RecordingWriter* recorder, LoopOptions options, PipelineSettings settings,
+FrameLoop::FrameLoop(io::FrameSource& source, core::PairPipeline& pipeline, std::vector<io::TouchSink*> sinks,
+                     io::RecordingWriter* recorder, LoopOptions options, core::PipelineSettings settings,
                      std::function<void()> notify, SettingsHook onSettings)
     : source_(source),
+      pipeline_(pipeline),
       sinks_(std::move(sinks)),
       recorder_(recorder),
       options_(options),
       notify_(std::move(notify)),
       onSettings_(std::move(onSettings)),
       queue_(options.queueCapacity, options.overflow),
-      settings_(std::move(settings)) {}
+      settings_(std::move(settings)),
+      pipelineMs_(kPipelineSamples, 0.0) {}
 
 FrameLoop::~FrameLoop() {
     stop();
@@ -45,7 +52,7 @@ void FrameLoop::start() {
         started_ = Clock::now();
     }
     heartbeatNs_ = Clock::now().time_since_epoch().count();
-    pipeline_ = std::thread([this] { runPipeline(); });
+    pipelineThread_ = std::thread([this] { runPipeline(); });
     camera_ = std::thread([this] { runCamera(); });
 }
 
@@ -54,8 +61,8 @@ void FrameLoop::stop() {
     queue_.close();
     if (camera_.joinable())
         camera_.join();
-    if (pipeline_.joinable())
-        pipeline_.join();
+    if (pipelineThread_.joinable())
+        pipelineThread_.join();
 }
 
 void FrameLoop::fail(const std::string& problem) {
@@ -69,9 +76,27 @@ std::optional<std::string> FrameLoop::failure() const {
     return failure_;
 }
 
+std::string FrameLoop::idleReason() const {
+    std::lock_guard lock(mutex_);
+    return idleReason_;
+}
+
 LoopStatistics FrameLoop::statistics() const {
     std::lock_guard lock(mutex_);
     LoopStatistics statistics = statistics_;
+    std::vector<double> times(
+        pipelineMs_.begin(),
+        pipelineMs_.begin() + static_cast<long>(std::min(pipelineSamples_, kPipelineSamples)));
+    if (!times.empty()) {
+        const auto at = [&times](double fraction) {
+            const auto nth =
+                times.begin() + static_cast<long>(fraction * static_cast<double>(times.size() - 1));
+            std::nth_element(times.begin(), nth, times.end());
+            return *nth;
+        };
+        statistics.pipelineMedianMs = at(0.5);
+        statistics.pipelineP99Ms = at(0.99);
+    }
     statistics.dropped = queue_.dropped();
     statistics.frameRate = arrivals_.perSecond(Clock::now());
     if (!finished_)
@@ -89,7 +114,7 @@ std::chrono::steady_clock::time_point FrameLoop::heartbeat() const {
     return Clock::time_point(Clock::duration(heartbeatNs_.load()));
 }
 
-void FrameLoop::setSettings(PipelineSettings settings) {
+void FrameLoop::setSettings(core::PipelineSettings settings) {
     std::lock_guard lock(mutex_);
     settings_ = std::move(settings);
     ++settingsVersion_;
@@ -154,11 +179,56 @@ void FrameLoop::publish(std::uint64_t frameIndex, std::int64_t timestampUs, cons
         notify_();
 }
 
+void FrameLoop::recordPipelineTime(double ms) {
+    std::lock_guard lock(mutex_);
+    pipelineMs_[pipelineSamples_ % kPipelineSamples] = ms;
+    ++pipelineSamples_;
+}
+
+void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSettings& settings) {
+    const Clock::time_point start = Clock::now();
+    const core::PipelineResult* result = nullptr;
+    try {
+        result = &pipeline_.process(pair, settings);
+    } catch (const std::exception& error) {
+        // Every contact goes at once; the failure is told once, not for every pair while it lasts.
+        pipeline_.reset();
+        if (detecting_.exchange(false))
+            notify_();
+        {
+            std::lock_guard lock(mutex_);
+            ++statistics_.pipelineFailures;
+            idleReason_ = std::string("detection failed: ") + error.what();
+        }
+        if (!failing_)
+            ET_LOG(Error) << "detection failed on frame " << pair.latest().index << ": " << error.what()
+                          << "; every contact is released until it works again";
+        failing_ = true;
+        tap_.offer(pair, nullptr);
+        publish(pair.latest().index, pair.latest().timestampUs, core::Contacts{});
+        return;
+    }
+    if (failing_)
+        ET_LOG(Notice) << "detection works again from frame " << pair.latest().index;
+    failing_ = false;
+    recordPipelineTime(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    const bool changed = detecting_ != result->detecting;
+    if (changed || !result->detecting) {
+        std::lock_guard lock(mutex_);
+        idleReason_ = result->idleReason;
+    }
+    detecting_ = result->detecting;
+    if (changed)
+        notify_();
+    tap_.offer(pair, result);
+    publish(result->frameIndex, result->timestampUs, result->contacts);
+}
+
 void FrameLoop::runPipeline() {
     QueuedFrame item;
     std::uint64_t lastIndex = 0;
     std::int64_t lastTimestampUs = 0;
-    PipelineSettings settings;
+    core::PipelineSettings settings;
     std::uint64_t settingsVersion = ~std::uint64_t{0};
     const core::Contacts noContacts;
     try {
@@ -186,10 +256,7 @@ void FrameLoop::runPipeline() {
             }
             if (newSettings && onSettings_)
                 onSettings_(settings);
-            tap_.offer(*pair);
-            // Detection stages plug in here: the contacts of `*pair` under `settings` (calibration, touch
-            // height). Until they exist no finger is ever reported.
-            publish(item.frame.index, item.frame.timestampUs, noContacts);
+            processPair(*pair, settings);
             const double latencyS = std::chrono::duration<double>(Clock::now() - item.arrival).count();
             std::lock_guard lock(mutex_);
             const double weight =
@@ -200,6 +267,7 @@ void FrameLoop::runPipeline() {
         fail(std::string("pipeline: ") + error.what());
     }
     try {
+        pipeline_.reset();
         publish(lastIndex, lastTimestampUs, noContacts);
     } catch (const std::exception& error) {
         fail(std::string("releasing the contacts: ") + error.what());

@@ -13,6 +13,7 @@
 #include "core/calibration.h"
 #include "core/contact.h"
 #include "core/frame_pairer.h"
+#include "core/touch_pipeline.h"
 #include "io/frame_source.h"
 #include "io/recording.h"
 #include "io/touch_sink.h"
@@ -29,6 +30,11 @@ struct LoopStatistics {
     double frameRate = 0.0;     // camera frames per second over the last second
     double latencyMs = 0.0;  // from a frame's arrival to its contacts reaching the sinks, smoothed over ~1 s
     double seconds = 0.0;    // wall-clock time since start, or of the whole run once finished
+    // The detection pipeline's time per pair over the last kPipelineSamples pairs, ms (thread CPU time is not
+    // measured: this is wall time on the pipeline thread, what the latency is made of).
+    double pipelineMedianMs = 0.0;
+    double pipelineP99Ms = 0.0;
+    std::uint64_t pipelineFailures = 0;  // pairs on which a stage failed; their contacts were released
 };
 
 struct LoopOptions {
@@ -37,26 +43,21 @@ struct LoopOptions {
     FrameQueue::Overflow overflow = FrameQueue::Overflow::DropOldest;  // Block for sources that can wait
 };
 
-// What the pipeline stages need besides the frames; set from the main thread, read by the pipeline thread.
-struct PipelineSettings {
-    std::optional<core::Calibration> calibration;  // nothing while uncalibrated: no contacts can be found
-    double touchHeightMm = 0.0;                    // a finger at or below this height touches
-};
-
 // Runs on the pipeline thread when new settings take effect, before the next pair: the place for sinks that
 // depend on the calibration (the virtual touchscreen's size).
-using SettingsHook = std::function<void(const PipelineSettings&)>;
+using SettingsHook = std::function<void(const core::PipelineSettings&)>;
 
-// Carries frames from a source through pairing and the pipeline stages to the sinks: a camera thread reads
-// the source into a bounded queue, a pipeline thread pairs frames, runs the stages and publishes contacts.
-// The owner (the main thread) hears about news through `notify` and reads them here.
+// Carries frames from a source through pairing and the detection pipeline to the sinks: a camera thread
+// reads the source into a bounded queue, a pipeline thread pairs each new frame with the previous one, runs
+// `pipeline` on the pair and publishes its contacts. The owner (the main thread) hears about news through
+// `notify` and reads them here.
 class FrameLoop {
 public:
     // `notify` runs on the loop's threads whenever the contacts change or the loop ends; it must be cheap and
-    // thread-safe.
-    FrameLoop(io::FrameSource& source, std::vector<io::TouchSink*> sinks, io::RecordingWriter* recorder,
-              LoopOptions options, PipelineSettings settings, std::function<void()> notify,
-              SettingsHook onSettings = nullptr);
+    // thread-safe. `pipeline` is used by the pipeline thread only, and must outlive the loop.
+    FrameLoop(io::FrameSource& source, core::PairPipeline& pipeline, std::vector<io::TouchSink*> sinks,
+              io::RecordingWriter* recorder, LoopOptions options, core::PipelineSettings settings,
+              std::function<void()> notify, SettingsHook onSettings = nullptr);
     ~FrameLoop();
     FrameLoop(const FrameLoop&) = delete;
     FrameLoop& operator=(const FrameLoop&) = delete;
@@ -77,16 +78,22 @@ public:
     // The last time the pipeline thread showed it is alive (it wakes at least every 100 ms).
     std::chrono::steady_clock::time_point heartbeat() const;
 
-    void setSettings(PipelineSettings settings);
+    void setSettings(core::PipelineSettings settings);
+    // Whether detection ran on the last pair (calibrated, the code known, no failure); why not, when not.
+    bool detecting() const { return detecting_; }
+    std::string idleReason() const;
     FrameTap& tap() { return tap_; }
 
 private:
     void runCamera();
     void runPipeline();
     void publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts);
+    void processPair(const core::FramePair& pair, const core::PipelineSettings& settings);
+    void recordPipelineTime(double ms);
     void fail(const std::string& problem);
 
     io::FrameSource& source_;
+    core::PairPipeline& pipeline_;
     std::vector<io::TouchSink*> sinks_;
     io::RecordingWriter* recorder_;
     LoopOptions options_;
@@ -98,9 +105,11 @@ private:
 
     std::atomic<bool> stopping_{false};
     std::atomic<bool> finished_{false};
+    std::atomic<bool> detecting_{false};
+    bool failing_ = false;  // pipeline thread only: the last pair failed, so the failure was logged once
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
-    std::thread pipeline_;
+    std::thread pipelineThread_;
 
     mutable std::mutex mutex_;  // guards everything below
     LoopStatistics statistics_;
@@ -109,8 +118,12 @@ private:
     core::Contacts contacts_;
     std::uint64_t contactsVersion_ = 0;
     std::optional<std::string> failure_;
-    PipelineSettings settings_;
+    core::PipelineSettings settings_;
     std::uint64_t settingsVersion_ = 0;
+    std::string idleReason_;
+    // The last pipeline times (ms) in a ring, preallocated: recording one allocates nothing.
+    std::vector<double> pipelineMs_;
+    std::size_t pipelineSamples_ = 0;
 };
 
 }  // namespace everytouch::service

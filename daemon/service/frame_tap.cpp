@@ -11,6 +11,20 @@ core::FramePair deepCopy(const core::FramePair& pair) {
     return copy;
 }
 
+std::shared_ptr<const core::PipelineResult> deepCopy(const core::PipelineResult& result) {
+    auto copy = std::make_shared<core::PipelineResult>();
+    copy->frameIndex = result.frameIndex;
+    copy->timestampUs = result.timestampUs;
+    copy->detecting = result.detecting;
+    copy->idleReason = result.idleReason;
+    copy->subtraction = result.subtraction.clone();
+    copy->texture = result.texture.clone();
+    copy->handMask = result.handMask.clone();
+    copy->fingertips = result.fingertips;
+    copy->contacts = result.contacts;
+    return copy;
+}
+
 }  // namespace
 
 FrameTap::Ticket FrameTap::request(std::size_t pairs, Done done) {
@@ -27,13 +41,13 @@ void FrameTap::cancel(Ticket ticket) {
     wanted_ = !pending_.empty();
 }
 
-void FrameTap::offer(const core::FramePair& pair) {
+void FrameTap::offer(const core::FramePair& pair, const core::PipelineResult* detection) {
     if (!wanted_.load(std::memory_order_relaxed))
         return;
     std::vector<Pending> filled;
     {
         std::lock_guard lock(mutex_);
-        const core::FramePair copy = deepCopy(pair);
+        const TappedPair copy{deepCopy(pair), detection ? deepCopy(*detection) : nullptr};
         for (auto it = pending_.begin(); it != pending_.end();) {
             it->second.pairs.push_back(copy);
             if (it->second.pairs.size() < it->second.wanted) {
@@ -47,6 +61,20 @@ void FrameTap::offer(const core::FramePair& pair) {
     }
     for (Pending& request : filled)
         request.done(std::move(request.pairs));
+}
+
+std::shared_ptr<const core::PipelineResult> deepCopy(const core::PipelineResult& result) {
+    auto copy = std::make_shared<core::PipelineResult>();
+    copy->frameIndex = result.frameIndex;
+    copy->timestampUs = result.timestampUs;
+    copy->detecting = result.detecting;
+    copy->idleReason = result.idleReason;
+    copy->subtraction = result.subtraction.clone();
+    copy->texture = result.texture.clone();
+    copy->handMask = result.handMask.clone();
+    copy->fingertips = result.fingertips;
+    copy->contacts = result.contacts;
+    return copy;
 }
 
 }  // namespace everytouch::service

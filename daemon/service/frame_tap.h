@@ -5,12 +5,22 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <vector>
 
 #include "core/frame.h"
+#include "core/touch_pipeline.h"
 
 namespace everytouch::service {
+
+// A frame pair as the pipeline thread formed it, and what detection made of it.
+struct TappedPair {
+    core::FramePair pair;
+    // The pipeline's result for the pair (its images, mask, fingertips and contacts), copied; nothing when
+    // the pair did not reach the pipeline.
+    std::shared_ptr<const core::PipelineResult> detection;
+};
 
 // Copies of the next frame pairs the pipeline forms, for whoever asks: a snapshot wants one, a calibration
 // step several. The pipeline thread pays for a copy only while someone waits.
@@ -18,20 +28,20 @@ class FrameTap {
 public:
     using Ticket = std::uint64_t;
     // Runs on the pipeline thread with the requested pairs; must be quick (hand them over and return).
-    using Done = std::function<void(std::vector<core::FramePair>&&)>;
+    using Done = std::function<void(std::vector<TappedPair>&&)>;
 
     // Asks for the next `pairs` pairs; `done` receives them.
     Ticket request(std::size_t pairs, Done done);
     // Withdraws a request; `done` will not run unless it already has.
     void cancel(Ticket ticket);
 
-    // Pipeline thread: a new pair was formed.
-    void offer(const core::FramePair& pair);
+    // Pipeline thread: a new pair was formed and, unless `detection` is null, processed.
+    void offer(const core::FramePair& pair, const core::PipelineResult* detection);
 
 private:
     struct Pending {
         std::size_t wanted = 0;
-        std::vector<core::FramePair> pairs;
+        std::vector<TappedPair> pairs;
         Done done;
     };
 

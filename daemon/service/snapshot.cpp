@@ -22,24 +22,26 @@ std::optional<SnapshotKind> parseSnapshotKind(std::string_view name) {
         return SnapshotKind::Texture;
     if (name == "subtraction")
         return SnapshotKind::Subtraction;
+    if (name == "mask")
+        return SnapshotKind::Mask;
     if (name == "overlay")
         return SnapshotKind::Overlay;
     return std::nullopt;
 }
 
-bool snapshotNeedsDetection(std::string_view name) {
-    return name == "mask";
-}
-
-void renderSnapshot(SnapshotKind kind, const core::FramePair& pair,
-                    const std::optional<core::Calibration>& calibration, const core::Contacts& contacts,
-                    cv::Mat& image) {
+void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, const core::PipelineResult* detection,
+                    const std::optional<core::Calibration>& calibration, cv::Mat& image) {
     if (kind == SnapshotKind::Camera) {
         pair.latest().image.copyTo(image);
         return;
     }
     cv::Mat subtraction, texture;
-    core::computeSubtractionAndTexture(pair, subtraction, texture);
+    if (detection) {
+        subtraction = detection->subtraction;
+        texture = detection->texture;
+    } else {
+        core::computeSubtractionAndTexture(pair, subtraction, texture);
+    }
     switch (kind) {
         case SnapshotKind::Texture:
             image = texture;
@@ -47,12 +49,20 @@ void renderSnapshot(SnapshotKind kind, const core::FramePair& pair,
         case SnapshotKind::Subtraction:
             subtraction.convertTo(image, CV_8U);  // saturates: negative differences become 0
             return;
+        case SnapshotKind::Mask:
+            if (detection && !detection->handMask.empty())
+                image = detection->handMask;
+            else
+                image = cv::Mat::zeros(texture.size(), CV_8UC1);
+            return;
         case SnapshotKind::Overlay:
             if (texture.channels() == 1)
                 cv::cvtColor(texture, image, cv::COLOR_GRAY2BGR);
             else
-                image = texture;
-            drawOverlay(calibration, contacts, image);
+                image = texture.clone();
+            if (detection)
+                drawDetection(*detection, image);
+            drawOverlay(calibration, detection ? detection->contacts : core::Contacts{}, image);
             return;
         case SnapshotKind::Camera:
             return;

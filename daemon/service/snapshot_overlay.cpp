@@ -82,4 +82,22 @@ void drawOverlay(const std::optional<core::Calibration>& calibration, const core
         drawContact(*calibration, contact, 6 * scale, image);
 }
 
+void drawDetection(const core::PipelineResult& detection, cv::Mat& image) {
+    const cv::Scalar handColour(255, 128, 0);
+    const cv::Scalar fingertipColour(255, 0, 255);
+    if (!detection.handMask.empty()) {
+        std::vector<std::vector<cv::Point>> outlines;
+        cv::findContours(detection.handMask, outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+        cv::drawContours(image, outlines, -1, handColour, 1, cv::LINE_AA);
+    }
+    for (const core::FingertipObservation& observation : detection.fingertips) {
+        const core::Fingertip& tip = observation.fingertip;
+        const cv::Point end(cvRound(tip.tip.x()), cvRound(tip.tip.y()));
+        const Eigen::Vector2d back = tip.tip - 1.5 * tip.widthPx * tip.direction;
+        cv::line(image, end, cv::Point(cvRound(back.x()), cvRound(back.y())), fingertipColour, 1,
+                 cv::LINE_AA);
+        cv::drawMarker(image, end, fingertipColour, cv::MARKER_CROSS, 9, 1);
+    }
+}
+
 }  // namespace everytouch::service

@@ -6,6 +6,7 @@
 
 #include "core/calibration.h"
 #include "core/contact.h"
+#include "core/touch_pipeline.h"
 
 namespace everytouch::service {
 
@@ -15,5 +16,9 @@ namespace everytouch::service {
 // with its id and height in mm. Without a calibration there is nowhere to draw them; the image says so.
 void drawOverlay(const std::optional<core::Calibration>& calibration, const core::Contacts& contacts,
                  cv::Mat& image);
+
+// Draws what detection found in the camera image: the hand's outline (blue) and each fingertip (a cross at
+// its end, a line along the finger).
+void drawDetection(const core::PipelineResult& detection, cv::Mat& image);
 
 }  // namespace everytouch::service

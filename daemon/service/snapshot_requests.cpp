@@ -46,8 +46,8 @@ void SnapshotRequests::add(SnapshotKind kind, int fd, SnapshotReply reply) {
         throw BusError(SD_BUS_ERROR_FAILED, std::string("Cannot set a timeout: ") + std::strerror(-r));
     }
     request.timeout.reset(timeout);
-    request.ticket = loop_.tap().request(1, [this, id](std::vector<core::FramePair>&& pairs) {
-        inbox_.post([this, id, pair = std::move(pairs.front())] { complete(id, pair); });
+    request.ticket = loop_.tap().request(1, [this, id](std::vector<TappedPair>&& pairs) {
+        inbox_.post([this, id, tapped = std::move(pairs.front())] { complete(id, tapped); });
     });
 }
 
@@ -56,12 +56,12 @@ void SnapshotRequests::failAll(const char* errorName, const std::string& message
         fail(requests_.begin()->first, errorName, message);
 }
 
-void SnapshotRequests::complete(std::uint64_t id, const core::FramePair& pair) {
+void SnapshotRequests::complete(std::uint64_t id, const TappedPair& tapped) {
     const auto it = requests_.find(id);
     if (it == requests_.end())
         return;
     cv::Mat image;
-    render_(it->second.kind, pair, image);
+    render_(it->second.kind, tapped, image);
     const int r = writeAllWithin(it->second.fd.get(), encodePng(image), timeouts_.write);
     if (r < 0) {
         fail(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-r));

@@ -18,8 +18,9 @@
 
 namespace everytouch::service {
 
-// Draws `kind` of `pair` into `image` (8-bit) for a snapshot. Runs on the main thread.
-using SnapshotRenderer = std::function<void(SnapshotKind kind, const core::FramePair& pair, cv::Mat& image)>;
+// Draws `kind` of a pair and what detection made of it into `image` (8-bit) for a snapshot. Runs on the main
+// thread.
+using SnapshotRenderer = std::function<void(SnapshotKind kind, const TappedPair& tapped, cv::Mat& image)>;
 
 // How one Snapshot call is answered. Both run on the main thread; exactly one of them runs, once.
 struct SnapshotReply {
@@ -66,7 +67,7 @@ private:
         io::EventSource timeout;
     };
 
-    void complete(std::uint64_t id, const core::FramePair& pair);
+    void complete(std::uint64_t id, const TappedPair& tapped);
     void fail(std::uint64_t id, const char* errorName, const std::string& message);
     static int onTimeout(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
 

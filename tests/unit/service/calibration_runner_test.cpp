@@ -32,7 +32,7 @@ public:
                   core::FramePair pair;
                   pair.positive.index = n - 1;
                   pair.negative.index = n;
-                  tap.offer(pair);
+                  tap.offer(pair, nullptr);
                   offered_ = n;
                   std::this_thread::sleep_for(1ms);
               }

@@ -1,5 +1,6 @@
 #include "service/frame_loop.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -25,11 +26,17 @@ public:
         std::this_thread::sleep_for(delay_);
         std::lock_guard lock(mutex_);
         indices_.push_back(frameIndex);
+        if (!contacts.empty())
+            touchedIn_.push_back(frameIndex);
         lastWasEmpty_ = contacts.empty();
     }
     std::vector<std::uint64_t> indices() const {
         std::lock_guard lock(mutex_);
         return indices_;
+    }
+    std::vector<std::uint64_t> touchedIn() const {
+        std::lock_guard lock(mutex_);
+        return touchedIn_;
     }
     bool lastWasEmpty() const {
         std::lock_guard lock(mutex_);
@@ -40,7 +47,40 @@ private:
     std::chrono::milliseconds delay_;
     mutable std::mutex mutex_;
     std::vector<std::uint64_t> indices_;
+    std::vector<std::uint64_t> touchedIn_;
     bool lastWasEmpty_ = false;
+};
+
+// A pipeline whose result is scripted: from frame `touchFrom` on a finger touches; on frame `failOn` a stage
+// throws. It sees every pair it gets.
+class ScriptedPipeline final : public core::PairPipeline {
+public:
+    std::uint64_t touchFrom = 1000;
+    std::uint64_t failOn = 1000;
+
+    const core::PipelineResult& process(const core::FramePair& pair, const core::PipelineSettings&) override {
+        const std::uint64_t index = pair.latest().index;
+        processed.push_back(index);
+        if (index == failOn)
+            throw std::runtime_error("scripted failure");
+        result_.frameIndex = index;
+        result_.timestampUs = pair.latest().timestampUs;
+        result_.detecting = true;
+        result_.handMask = cv::Mat(pair.latest().image.size(), CV_8UC1, cv::Scalar(index));
+        if (index >= touchFrom && result_.contacts.empty())
+            result_.contacts.push_back(core::Contact{7, 10.0, 20.0, true, 0.0, false});
+        return result_;
+    }
+    void reset() override {
+        ++resets;
+        result_.contacts.clear();
+    }
+
+    std::vector<std::uint64_t> processed;  // pipeline thread; read after the loop finished
+    int resets = 0;
+
+private:
+    core::PipelineResult result_;
 };
 
 // What the main thread would be told.
@@ -70,6 +110,7 @@ protected:
 
     test::TempDir dir_;
     Notifications notifications_;
+    ScriptedPipeline pipeline_;
 };
 
 TEST_F(FrameLoopTest, RunsToTheEndOfTheStreamAndReleasesTheContacts) {
@@ -77,7 +118,7 @@ TEST_F(FrameLoopTest, RunsToTheEndOfTheStreamAndReleasesTheContacts) {
     CollectingSink sink;
     LoopOptions options;
     options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, {&sink}, nullptr, options, PipelineSettings{}, notifications_.callback());
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
     loop.start();
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     const LoopStatistics statistics = loop.statistics();
@@ -97,7 +138,7 @@ TEST_F(FrameLoopTest, StopsAfterMaxFrames) {
     LoopOptions options;
     options.maxFrames = 7;
     options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, {&sink}, nullptr, options, PipelineSettings{}, notifications_.callback());
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
     loop.start();
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     EXPECT_EQ(loop.statistics().frames, 7u);
@@ -109,7 +150,7 @@ TEST_F(FrameLoopTest, ASlowPipelineDropsTheOldestFramesAndCountsThem) {
     CollectingSink slowSink(20ms);
     LoopOptions options;
     options.queueCapacity = 2;
-    FrameLoop loop(source, {&slowSink}, nullptr, options, PipelineSettings{}, notifications_.callback());
+    FrameLoop loop(source, pipeline_, {&slowSink}, nullptr, options, {}, notifications_.callback());
     loop.start();
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     const LoopStatistics statistics = loop.statistics();
@@ -122,10 +163,10 @@ TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
     io::ReplaySource source(dir_ / "recording", false);
     LoopOptions options;
     options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, {}, nullptr, options, PipelineSettings{}, notifications_.callback());
+    FrameLoop loop(source, pipeline_, {}, nullptr, options, {}, notifications_.callback());
     std::mutex mutex;
-    std::vector<core::FramePair> captured;
-    loop.tap().request(3, [&](std::vector<core::FramePair>&& pairs) {
+    std::vector<TappedPair> captured;
+    loop.tap().request(3, [&](std::vector<TappedPair>&& pairs) {
         std::lock_guard lock(mutex);
         captured = std::move(pairs);
     });
@@ -133,10 +174,55 @@ TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     std::lock_guard lock(mutex);
     ASSERT_EQ(captured.size(), 3u);
-    for (std::size_t i = 0; i < captured.size(); ++i)
-        EXPECT_EQ(captured[i].latest().index, i + 1);
+    for (std::size_t i = 0; i < captured.size(); ++i) {
+        EXPECT_EQ(captured[i].pair.latest().index, i + 1);
+        // What the pipeline made of that very pair travels with it, copied.
+        ASSERT_TRUE(captured[i].detection);
+        EXPECT_EQ(captured[i].detection->frameIndex, i + 1);
+        EXPECT_EQ(captured[i].detection->handMask.at<uchar>(0, 0), i + 1);
+    }
     const test::CodedImages images = test::codedImages(test::smallRig().calibration.cameraSize, 10);
-    EXPECT_EQ(cv::norm(captured[0].positive.image, images.positive, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(captured[0].pair.positive.image, images.positive, cv::NORM_INF), 0.0);
+}
+
+TEST_F(FrameLoopTest, EveryNewFrameIsPairedAndItsContactsReachTheSinks) {
+    io::ReplaySource source(dir_ / "recording", false);
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    pipeline_.touchFrom = 5;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    loop.start();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    std::vector<std::uint64_t> expected;
+    for (std::uint64_t i = 1; i < 20; ++i)
+        expected.push_back(i);
+    EXPECT_EQ(pipeline_.processed, expected);
+    const std::vector<std::uint64_t> touched = sink.touchedIn();
+    ASSERT_FALSE(touched.empty());
+    EXPECT_EQ(touched.front(), 5u);
+    EXPECT_EQ(touched.size(), 15u);
+    EXPECT_TRUE(sink.lastWasEmpty());  // the end of the stream releases the finger
+    EXPECT_TRUE(loop.detecting());
+    EXPECT_GT(loop.statistics().pipelineMedianMs, 0.0);
+}
+
+TEST_F(FrameLoopTest, AFailingStageReleasesEveryContactInThatFrameAndTheLoopGoesOn) {
+    io::ReplaySource source(dir_ / "recording", false);
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    pipeline_.touchFrom = 3;
+    pipeline_.failOn = 9;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    loop.start();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    const std::vector<std::uint64_t> touched = sink.touchedIn();
+    EXPECT_EQ(std::count(touched.begin(), touched.end(), 9u), 0);   // released in the failing frame itself
+    EXPECT_EQ(std::count(touched.begin(), touched.end(), 10u), 1);  // and found again afterwards
+    EXPECT_FALSE(loop.failure());                                   // one bad pair does not end the loop
+    EXPECT_EQ(loop.statistics().pipelineFailures, 1u);
+    EXPECT_GE(pipeline_.resets, 1);
 }
 
 TEST_F(FrameLoopTest, ACameraFailureEndsTheLoopWithTheReason) {
@@ -145,7 +231,7 @@ TEST_F(FrameLoopTest, ACameraFailureEndsTheLoopWithTheReason) {
     CollectingSink sink;
     LoopOptions options;
     options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, {&sink}, nullptr, options, PipelineSettings{}, notifications_.callback());
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
     loop.start();
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     ASSERT_TRUE(loop.failure());

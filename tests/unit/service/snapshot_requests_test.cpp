@@ -49,7 +49,8 @@ struct MarkingRenderer {
     std::vector<SnapshotKind> kinds;
 
     SnapshotRenderer function() {
-        return [this](SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
+        return [this](SnapshotKind kind, const TappedPair& tapped, cv::Mat& image) {
+            const core::FramePair& pair = tapped.pair;
             kinds.push_back(kind);
             image = cv::Mat(pair.latest().image.size(), CV_8UC1, cv::Scalar(77));
             image.at<uchar>(0, 0) = static_cast<uchar>(pair.latest().index);
@@ -96,13 +97,14 @@ protected:
 
     test::TempDir dir_;
     LoopOptions options_;
+    core::TouchPipeline pipeline_;  // uncalibrated: the pairs pass through without detection
     io::Event event_;
     MainLoopInbox inbox_;
 };
 
 TEST_F(SnapshotRequestsTest, WritesTheRenderedNextPairAndAnswersTheCall) {
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
     Answers answers;
@@ -127,7 +129,7 @@ TEST_F(SnapshotRequestsTest, WritesTheRenderedNextPairAndAnswersTheCall) {
 
 TEST_F(SnapshotRequestsTest, WithoutFramesTheRequestFailsAfterItsTimeoutAndStaysAnswered) {
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function(),
                               SnapshotTimeouts{50ms, 3000ms});
@@ -154,7 +156,7 @@ TEST_F(SnapshotRequestsTest, WithoutFramesTheRequestFailsAfterItsTimeoutAndStays
 
 TEST_F(SnapshotRequestsTest, RefusesADescriptorNotOpenForWriting) {
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
     Answers answers;
@@ -167,7 +169,7 @@ TEST_F(SnapshotRequestsTest, RefusesADescriptorNotOpenForWriting) {
 
 TEST_F(SnapshotRequestsTest, RefusesOnceTheCameraHasEnded) {
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
     loop.start();
@@ -182,7 +184,7 @@ TEST_F(SnapshotRequestsTest, RefusesOnceTheCameraHasEnded) {
 TEST_F(SnapshotRequestsTest, AReaderThatWentAwayGetsAnIoError) {
     std::signal(SIGPIPE, SIG_IGN);  // as everytouchd does
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
     int ends[2];
@@ -204,7 +206,7 @@ TEST_F(SnapshotRequestsTest, AReaderThatWentAwayGetsAnIoError) {
 
 TEST_F(SnapshotRequestsTest, FailAllAnswersEveryPendingRequest) {
     io::ReplaySource source(dir_ / "recording", false);
-    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
     MarkingRenderer renderer;
     SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
     Answers first, second;

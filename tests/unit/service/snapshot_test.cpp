@@ -33,19 +33,56 @@ core::FramePair pairOf(const cv::Mat& positive, const cv::Mat& negative) {
 TEST(Snapshot, NamesAreParsed) {
     EXPECT_EQ(parseSnapshotKind("texture"), SnapshotKind::Texture);
     EXPECT_EQ(parseSnapshotKind("overlay"), SnapshotKind::Overlay);
-    EXPECT_FALSE(parseSnapshotKind("mask"));
-    EXPECT_TRUE(snapshotNeedsDetection("mask"));
-    EXPECT_FALSE(snapshotNeedsDetection("overlay"));
-    EXPECT_FALSE(snapshotNeedsDetection("photo"));
+    EXPECT_EQ(parseSnapshotKind("mask"), SnapshotKind::Mask);
+    EXPECT_FALSE(parseSnapshotKind("photo"));
+}
+
+TEST(Snapshot, MaskAndImagesComeFromTheDetectionResultNotARecomputation) {
+    const test::CodedImages images = test::codedImages({64, 48}, 10);
+    const core::FramePair pair = pairOf(images.positive, images.negative);
+    core::PipelineResult detection;
+    detection.texture = cv::Mat(48, 64, images.positive.type(), cv::Scalar::all(33));
+    detection.subtraction = cv::Mat(48, 64, CV_16SC1, cv::Scalar(21));
+    detection.handMask = cv::Mat::zeros(48, 64, CV_8UC1);
+    detection.handMask(cv::Rect(10, 10, 20, 20)).setTo(255);
+    cv::Mat mask, texture, subtraction;
+    renderSnapshot(SnapshotKind::Mask, pair, &detection, std::nullopt, mask);
+    renderSnapshot(SnapshotKind::Texture, pair, &detection, std::nullopt, texture);
+    renderSnapshot(SnapshotKind::Subtraction, pair, &detection, std::nullopt, subtraction);
+    EXPECT_EQ(cv::norm(mask, detection.handMask, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::norm(texture, detection.texture, cv::NORM_INF), 0.0);
+    EXPECT_EQ(subtraction.at<uchar>(5, 5), 21);
+    // Without a detection (the pair never reached the pipeline) the mask is empty, not made up.
+    renderSnapshot(SnapshotKind::Mask, pair, nullptr, std::nullopt, mask);
+    EXPECT_EQ(cv::countNonZero(mask), 0);
+}
+
+TEST(Snapshot, OverlayDrawsTheHandOutlineAndTheFingertips) {
+    const cv::Mat gray(120, 160, CV_8UC1, cv::Scalar(128));
+    core::PipelineResult detection;
+    cv::cvtColor(gray, detection.texture, cv::COLOR_GRAY2BGR);
+    detection.subtraction = cv::Mat::zeros(gray.size(), CV_16SC1);
+    detection.handMask = cv::Mat::zeros(gray.size(), CV_8UC1);
+    detection.handMask(cv::Rect(60, 0, 20, 70)).setTo(255);
+    core::FingertipObservation finger;
+    finger.fingertip.tip = Eigen::Vector2d(70, 70);
+    finger.fingertip.direction = Eigen::Vector2d(0, 1);
+    finger.fingertip.widthPx = 20;
+    detection.fingertips.push_back(finger);
+    cv::Mat overlay;
+    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), &detection, std::nullopt, overlay);
+    EXPECT_NE(overlay.at<cv::Vec3b>(30, 60), cv::Vec3b(128, 128, 128)) << "no outline on the hand's edge";
+    EXPECT_NE(overlay.at<cv::Vec3b>(70, 70), cv::Vec3b(128, 128, 128)) << "no mark on the fingertip";
+    EXPECT_EQ(overlay.at<cv::Vec3b>(30, 30), cv::Vec3b(128, 128, 128)) << "drawn away from the hand";
 }
 
 TEST(Snapshot, TextureAndSubtractionSeparateSceneAndCode) {
     const test::CodedImages images = test::codedImages({64, 48}, 10);
     const core::FramePair pair = pairOf(images.positive, images.negative);
     cv::Mat camera, texture, subtraction;
-    renderSnapshot(SnapshotKind::Camera, pair, std::nullopt, {}, camera);
-    renderSnapshot(SnapshotKind::Texture, pair, std::nullopt, {}, texture);
-    renderSnapshot(SnapshotKind::Subtraction, pair, std::nullopt, {}, subtraction);
+    renderSnapshot(SnapshotKind::Camera, pair, nullptr, std::nullopt, camera);
+    renderSnapshot(SnapshotKind::Texture, pair, nullptr, std::nullopt, texture);
+    renderSnapshot(SnapshotKind::Subtraction, pair, nullptr, std::nullopt, subtraction);
     EXPECT_EQ(cv::norm(camera, images.negative, cv::NORM_INF), 0.0);  // the newer frame
     const cv::Mat table = (images.positive + images.negative) / 2;
     EXPECT_LE(cv::norm(texture, table, cv::NORM_INF), 1.0);
@@ -60,7 +97,7 @@ TEST(Snapshot, SubtractionTakesTheLargestChannelAndClipsNegatives) {
     cv::Mat negative(2, 2, CV_8UC3, cv::Scalar(90, 120, 95));
     positive.at<cv::Vec3b>(1, 1) = {50, 50, 50};
     cv::Mat subtraction;
-    renderSnapshot(SnapshotKind::Subtraction, pairOf(positive, negative), std::nullopt, {}, subtraction);
+    renderSnapshot(SnapshotKind::Subtraction, pairOf(positive, negative), nullptr, std::nullopt, subtraction);
     EXPECT_EQ(subtraction.at<std::uint8_t>(0, 0), 10);
     EXPECT_EQ(subtraction.at<std::uint8_t>(1, 1), 0);
 }
@@ -81,8 +118,12 @@ TEST(Snapshot, OverlayDrawsTheDisplayOutlineAndTheContactsWhereTheCalibrationPut
     const cv::Point2d centre(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0);
     core::Contact touching{.id = 1, .x = centre.x, .y = centre.y, .touching = true};
     core::Contact hovering{.id = 2, .x = centre.x / 2, .y = centre.y, .heightMm = 60.0};
+    core::PipelineResult detection;
+    cv::cvtColor(gray, detection.texture, cv::COLOR_GRAY2BGR);
+    detection.subtraction = cv::Mat::zeros(gray.size(), CV_16SC1);
+    detection.contacts = {touching, hovering};
     cv::Mat overlay;
-    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), calibration, {touching, hovering}, overlay);
+    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), &detection, calibration, overlay);
     ASSERT_EQ(overlay.type(), CV_8UC3);
     ASSERT_EQ(overlay.size(), calibration.cameraSize);
 
@@ -118,7 +159,7 @@ TEST(Snapshot, OverlayDrawsTheDisplayOutlineAndTheContactsWhereTheCalibrationPut
 TEST(Snapshot, OverlaySaysWhenThereIsNoCalibration) {
     const cv::Mat gray(120, 160, CV_8UC1, cv::Scalar(128));
     cv::Mat overlay;
-    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), std::nullopt, {}, overlay);
+    renderSnapshot(SnapshotKind::Overlay, pairOf(gray, gray), nullptr, std::nullopt, overlay);
     ASSERT_EQ(overlay.type(), CV_8UC3);
     cv::Mat plain;
     cv::cvtColor(gray, plain, cv::COLOR_GRAY2BGR);

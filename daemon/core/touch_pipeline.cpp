@@ -1,0 +1,159 @@
+#include "core/touch_pipeline.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "core/camera_model.h"
+#include "core/code_image.h"
+#include "core/fill.h"
+#include "core/geometry.h"
+
+namespace everytouch::core {
+
+namespace {
+
+bool sameCalibration(const Calibration& a, const Calibration& b) {
+    return a.cameraSize == b.cameraSize && a.cameraMatrix == b.cameraMatrix &&
+           a.cameraDistortion == b.cameraDistortion && a.projectorSize == b.projectorSize &&
+           a.projectorMatrix == b.projectorMatrix && a.tableToCamera.matrix() == b.tableToCamera.matrix() &&
+           a.tableToProjector.matrix() == b.tableToProjector.matrix() && a.displaySize == b.displaySize &&
+           a.displayToProjector == b.displayToProjector;
+}
+
+// A fingertip stays put while it moves less than this fraction of its width between two frames.
+constexpr double kStillWidths = 0.1;
+// A fingertip of this frame is the one of the last frame when it lies within this fraction of its width.
+constexpr double kSameWidths = 0.5;
+
+}  // namespace
+
+std::optional<std::string> DetectionOptions::validate() const {
+    if (auto problem = segmentation.validate())
+        return "segmentation." + *problem;
+    if (auto problem = fingertips.validate())
+        return "fingertips." + *problem;
+    if (auto problem = height.validate())
+        return "height." + *problem;
+    if (auto problem = tracker.validate())
+        return "tracker." + *problem;
+    if (!(fingerWidthMm > 0.0 && fingerWidthMm < 50.0))
+        return "fingerWidthMm: must be in (0, 50) mm";
+    if (!(visibleAbovePadMm >= 0.0 && visibleAbovePadMm < 40.0))
+        return "visibleAbovePadMm: must be in [0, 40) mm";
+    if (!(evidenceDecay >= 0.0 && evidenceDecay < 1.0))
+        return "evidenceDecay: must be in [0, 1)";
+    return std::nullopt;
+}
+
+TouchPipeline::TouchPipeline(const DetectionOptions& options)
+    : options_(options),
+      segmenter_(options.segmentation),
+      height_(options.height),
+      tracker_(options.tracker),
+      remembered_(options.fingertips.maxFingertips),
+      rememberedNext_(options.fingertips.maxFingertips) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("detection options: " + *problem);
+    observations_.reserve(options.fingertips.maxFingertips);
+    result_.fingertips.reserve(options.fingertips.maxFingertips);
+    found_.reserve(options.fingertips.maxFingertips);
+}
+
+void TouchPipeline::reset() {
+    tracker_.reset();
+    rememberedCount_ = 0;
+    result_.contacts.clear();
+    result_.fingertips.clear();
+}
+
+void TouchPipeline::adoptRig(const PipelineSettings& settings) {
+    const Calibration& calibration = *settings.calibration;
+    if (rigCalibration_ && sameCalibration(*rigCalibration_, calibration) &&
+        rigPattern_.data == settings.pattern.data && rigPattern_.size() == settings.pattern.size())
+        return;
+    segmenter_.setRig(calibration, settings.pattern);
+    height_.setRig(calibration, settings.pattern);
+    options_.fingertips.fingerWidthPx = options_.fingerWidthMm * segmenter_.pixelsPerMm();
+    const cv::Size2d displayMm = calibration.displaySizeMm();
+    displayPixelsPerMm_ = calibration.displaySize.width / displayMm.width;
+    rigCalibration_ = calibration;
+    rigPattern_ = settings.pattern;
+    reset();
+}
+
+const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
+    result_.frameIndex = pair.latest().index;
+    result_.timestampUs = pair.latest().timestampUs;
+    computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
+    result_.handMask.create(result_.texture.size(), CV_8UC1);
+    if (!settings.calibration || settings.pattern.empty()) {
+        result_.detecting = false;
+        result_.idleReason = !settings.calibration ? "not calibrated" : "the projected code is not known";
+        fill(result_.handMask, 0);
+        reset();
+        return result_;
+    }
+    if (settings.pattern.size() != settings.calibration->projectorSize ||
+        result_.texture.size() != settings.calibration->cameraSize) {
+        result_.detecting = false;
+        result_.idleReason = "the camera or the code does not match the calibration's sizes";
+        fill(result_.handMask, 0);
+        reset();
+        return result_;
+    }
+    adoptRig(settings);
+    result_.detecting = true;
+    result_.idleReason.clear();
+    segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
+    findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_);
+    measureFingertips(settings);
+    tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
+                    result_.contacts);
+    return result_;
+}
+
+void TouchPipeline::measureFingertips(const PipelineSettings& settings) {
+    const Calibration& calibration = *settings.calibration;
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    result_.fingertips.clear();
+    observations_.clear();
+    int next = 0;
+    for (const Fingertip& tip : found_) {
+        height_.measureFingertip(result_.subtraction, result_.handMask, tip.tip, tip.direction, tip.widthPx,
+                                 frameEvidence_);
+        // The same fingertip in the last frame: its evidence carries over while it stays put.
+        int same = -1;
+        double nearest = kSameWidths * tip.widthPx;
+        for (int i = 0; i < rememberedCount_; ++i)
+            if (const double d = (remembered_[i].tip - tip.tip).norm(); d < nearest) {
+                nearest = d;
+                same = i;
+            }
+        Remembered& memory = rememberedNext_[next++];
+        memory.tip = tip.tip;
+        memory.widthPx = tip.widthPx;
+        memory.evidence.clear(height_.heights());
+        memory.evidence.add(frameEvidence_, 1.0);
+        if (same >= 0 && nearest < kStillWidths * tip.widthPx)
+            memory.evidence.add(remembered_[same].evidence, options_.evidenceDecay);
+
+        FingertipObservation& observation = result_.fingertips.emplace_back();
+        observation.fingertip = tip;
+        observation.visible = height_.estimate(memory.evidence);
+        if (!observation.visible.valid)
+            continue;  // the code on it is not seen well enough: no height, no contact this frame
+        observation.padHeightMm = std::max(0.0, observation.visible.heightMm - options_.visibleAbovePadMm);
+        // The contact point lies below the fingertip: its end seen through the plane of the pad's height.
+        const Eigen::Vector2d undistorted = camera.undistortPixel(tip.tip);
+        observation.display =
+            applyHomography(calibration.cameraToDisplayHomography(observation.padHeightMm), undistorted);
+        FingerObservation& finger = observations_.emplace_back();
+        finger.display = observation.display;
+        finger.padHeightMm = observation.padHeightMm;
+        finger.heightUncertaintyMm = observation.visible.uncertaintyMm;
+    }
+    std::swap(remembered_, rememberedNext_);
+    rememberedCount_ = next;
+}
+
+}  // namespace everytouch::core

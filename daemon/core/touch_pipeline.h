@@ -1,0 +1,117 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "core/calibration.h"
+#include "core/contact.h"
+#include "core/contact_tracker.h"
+#include "core/fingertips.h"
+#include "core/frame.h"
+#include "core/hand_segmentation.h"
+#include "core/surface_height.h"
+
+namespace everytouch::core {
+
+// What the pipeline needs besides the frames: set by the daemon, changed between two pairs.
+struct PipelineSettings {
+    std::optional<Calibration> calibration;  // nothing while uncalibrated: no contacts can be found
+    cv::Mat pattern;             // the code projected: CV_8UC1 0/1, projector size; empty when unknown
+    double touchHeightMm = 0.0;  // a finger pad at or below this height touches
+};
+
+// How the pipeline finds contacts. Each stage's options document themselves.
+struct DetectionOptions {
+    SegmentationOptions segmentation;
+    FingertipOptions fingertips;  // fingerWidthPx is set from the calibration
+    HeightOptions height;
+    TrackerOptions tracker;
+    // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
+    double fingerWidthMm = 16.0;
+    // How far above its pad the camera sees the back of a fingertip (mm), half a finger width behind its
+    // end: fingertips are 12-15 mm thick and round, so the surface seen there lies about 9 mm up.
+    double visibleAbovePadMm = 9.0;
+    // Evidence of earlier frames counts this much less each frame while a fingertip stays put (moves less
+    // than a tenth of its width): a half-life of about two frames keeps a touch-down's latency at one frame.
+    double evidenceDecay = 0.7;
+
+    std::optional<std::string> validate() const;
+};
+
+// One fingertip of one frame, as the pipeline saw it.
+struct FingertipObservation {
+    Fingertip fingertip;       // camera pixels
+    HeightEstimate visible;    // the visible surface's height on the fingertip, from this and earlier frames
+    double padHeightMm = 0.0;  // the pad's estimated height above the table
+    Eigen::Vector2d display = Eigen::Vector2d::Zero();  // the contact point, display pixels
+};
+
+// Everything one pair gave, kept until the next: the images the stages worked on, so that a snapshot shows
+// what detection really saw.
+struct PipelineResult {
+    std::uint64_t frameIndex = 0;
+    std::int64_t timestampUs = 0;
+    bool detecting = false;  // detection ran: calibrated and the code known
+    std::string idleReason;  // why it did not, when it did not
+    cv::Mat subtraction;     // S, CV_16SC1
+    cv::Mat texture;         // T, the frames' type
+    cv::Mat handMask;        // CV_8UC1, 255 on the hand; all 0 when not detecting
+    std::vector<FingertipObservation> fingertips;
+    Contacts contacts;  // tracked, in display pixels
+};
+
+// The seam between the frame loop and detection: one call per frame pair on the pipeline thread.
+class PairPipeline {
+public:
+    virtual ~PairPipeline() = default;
+    // The result stays valid until the next call. Throws on failures inside a stage; the caller then calls
+    // reset(), which releases every contact.
+    virtual const PipelineResult& process(const FramePair& pair, const PipelineSettings& settings) = 0;
+    virtual void reset() = 0;
+};
+
+// Segmentation, fingertips, height, tracking (docs/detection.md). Allocates nothing per pair once the
+// first pairs of a size have been seen.
+class TouchPipeline final : public PairPipeline {
+public:
+    // Throws std::invalid_argument when options.validate() fails.
+    explicit TouchPipeline(const DetectionOptions& options = {});
+
+    const PipelineResult& process(const FramePair& pair, const PipelineSettings& settings) override;
+    void reset() override;
+
+private:
+    // A fingertip remembered from the last frame: its evidence adds up while it stays put.
+    struct Remembered {
+        Eigen::Vector2d tip = Eigen::Vector2d::Zero();
+        double widthPx = 0.0;
+        HeightEvidence evidence;
+    };
+
+    void adoptRig(const PipelineSettings& settings);
+    void measureFingertips(const PipelineSettings& settings);
+
+    DetectionOptions options_;
+    HandSegmenter segmenter_;
+    SurfaceHeight height_;
+    ContactTracker tracker_;
+    FingertipScratch fingertipScratch_;
+    Fingertips found_;
+    std::optional<Calibration> rigCalibration_;  // the calibration the stages were prepared for
+    cv::Mat rigPattern_;
+    double displayPixelsPerMm_ = 1.0;
+    HeightEvidence frameEvidence_;
+    // Fixed capacity (the most fingertips), so that remembering allocates nothing; counts say what is used.
+    std::vector<Remembered> remembered_;
+    std::vector<Remembered> rememberedNext_;
+    int rememberedCount_ = 0;
+    std::vector<FingerObservation> observations_;
+    PipelineResult result_;
+};
+
+}  // namespace everytouch::core

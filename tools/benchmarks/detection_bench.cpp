@@ -1,0 +1,203 @@
+// Cost of detection per frame pair on one core, 648x488 (the simulated rig's defaults): segmentation with
+// fingertips, with one hand in view and with none; the paper's segmentation as published (stock mean shift
+// over the whole frame) for comparison; the height of one fingertip; the whole pipeline. Each benchmark
+// reports the median and the 99th percentile of its iterations as counters (ms).
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/code_image.h"
+#include "core/fingertips.h"
+#include "core/hand_segmentation.h"
+#include "core/surface_height.h"
+#include "core/touch_pipeline.h"
+#include "sim/simulator.h"
+
+namespace {
+
+using namespace everytouch;
+using Clock = std::chrono::steady_clock;
+
+// A few consecutive pairs of a scenario, rendered once and shared by the benchmarks.
+struct Scene {
+    sim::SimParameters parameters;
+    core::Calibration calibration;
+    cv::Mat pattern;
+    std::vector<core::FramePair> pairs;
+};
+
+Scene renderScene(const char* scenario, double startS, int pairs) {
+    Scene scene;
+    scene.parameters.scenario = scenario;
+    sim::Simulator simulator(scene.parameters, sim::rigPattern(scene.parameters));
+    scene.calibration = simulator.calibration();
+    scene.pattern = simulator.pattern();
+    auto index = static_cast<std::uint64_t>(startS * scene.parameters.frameRate) & ~std::uint64_t{1};
+    sim::FrameTruth truth;
+    for (int i = 0; i < pairs; ++i, index += 2) {
+        core::FramePair pair;
+        simulator.render(index, pair.positive, truth);
+        simulator.render(index + 1, pair.negative, truth);
+        scene.pairs.push_back(std::move(pair));
+    }
+    return scene;
+}
+
+// grid35 at 1.9 s: one hand with its forearm, the index finger pointing; idle: nothing but content.
+const Scene& oneHand() {
+    static const Scene scene = renderScene("grid35", 1.9, 8);
+    return scene;
+}
+const Scene& noHand() {
+    static const Scene scene = renderScene("idle", 1.0, 8);
+    return scene;
+}
+
+class Timings {
+public:
+    void add(Clock::duration d) { ms_.push_back(std::chrono::duration<double, std::milli>(d).count()); }
+    void report(benchmark::State& state) {
+        std::sort(ms_.begin(), ms_.end());
+        if (ms_.empty())
+            return;
+        state.counters["median_ms"] = ms_[ms_.size() / 2];
+        state.counters["p99_ms"] = ms_[static_cast<std::size_t>(0.99 * static_cast<double>(ms_.size() - 1))];
+    }
+
+private:
+    std::vector<double> ms_;
+};
+
+void segmentAndFindFingertips(benchmark::State& state, const Scene& scene, core::SegmentationMethod method) {
+    cv::setNumThreads(1);
+    core::SegmentationOptions options;
+    options.method = method;
+    core::HandSegmenter segmenter(options);
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::FingertipOptions fingertipOptions;
+    fingertipOptions.fingerWidthPx = 16.0 * segmenter.pixelsPerMm();
+    core::FingertipScratch scratch;
+    core::Fingertips fingertips;
+    std::vector<cv::Mat> textures(scene.pairs.size()), subtractions(scene.pairs.size());
+    for (std::size_t i = 0; i < scene.pairs.size(); ++i)
+        core::computeSubtractionAndTexture(scene.pairs[i], subtractions[i], textures[i]);
+    cv::Mat mask;
+    for (std::size_t k = 0; k < scene.pairs.size(); ++k) {  // the buffers sized
+        segmenter.segment(textures[k], subtractions[k], mask);
+        core::findFingertips(mask, fingertipOptions, scratch, fingertips);
+    }
+    Timings timings;
+    std::size_t i = 0, found = 0;
+    for (auto _ : state) {
+        const auto start = Clock::now();
+        segmenter.segment(textures[i], subtractions[i], mask);
+        core::findFingertips(mask, fingertipOptions, scratch, fingertips);
+        timings.add(Clock::now() - start);
+        found += fingertips.size();
+        i = (i + 1) % scene.pairs.size();
+    }
+    timings.report(state);
+    state.counters["fingertips"] = static_cast<double>(found) / static_cast<double>(state.iterations());
+}
+
+void BM_SegmentationAndFingertipsOneHand(benchmark::State& state) {
+    segmentAndFindFingertips(state, oneHand(), core::SegmentationMethod::Code);
+}
+BENCHMARK(BM_SegmentationAndFingertipsOneHand)->Unit(benchmark::kMillisecond);
+
+void BM_SegmentationAndFingertipsNoHand(benchmark::State& state) {
+    segmentAndFindFingertips(state, noHand(), core::SegmentationMethod::Code);
+}
+BENCHMARK(BM_SegmentationAndFingertipsNoHand)->Unit(benchmark::kMillisecond);
+
+void BM_PaperSegmentationOneHand(benchmark::State& state) {
+    segmentAndFindFingertips(state, oneHand(), core::SegmentationMethod::Paper);
+}
+BENCHMARK(BM_PaperSegmentationOneHand)->Unit(benchmark::kMillisecond)->Iterations(8);
+
+// The paper's method done straightforwardly: stock mean shift over the whole frame, nothing else.
+void BM_PaperMeanShiftWholeFrame(benchmark::State& state) {
+    cv::setNumThreads(1);
+    const Scene& scene = oneHand();
+    cv::Mat subtraction, texture, filtered;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    Timings timings;
+    for (auto _ : state) {
+        const auto start = Clock::now();
+        cv::pyrMeanShiftFiltering(texture, filtered, 7, 10, 1);
+        timings.add(Clock::now() - start);
+    }
+    timings.report(state);
+}
+BENCHMARK(BM_PaperMeanShiftWholeFrame)->Unit(benchmark::kMillisecond)->Iterations(8);
+
+void BM_HeightOfOneFingertip(benchmark::State& state) {
+    const Scene& scene = oneHand();
+    core::SegmentationOptions segmentationOptions;
+    core::HandSegmenter segmenter(segmentationOptions);
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::SurfaceHeight height(core::HeightOptions{});
+    height.setRig(scene.calibration, scene.pattern);
+    cv::Mat subtraction, texture, mask;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    segmenter.segment(texture, subtraction, mask);
+    core::FingertipOptions fingertipOptions;
+    fingertipOptions.fingerWidthPx = 16.0 * segmenter.pixelsPerMm();
+    core::FingertipScratch scratch;
+    core::Fingertips fingertips;
+    core::findFingertips(mask, fingertipOptions, scratch, fingertips);
+    if (fingertips.empty()) {
+        state.SkipWithError("no fingertip found in the scene");
+        return;
+    }
+    core::HeightEvidence evidence;
+    Timings timings;
+    for (auto _ : state) {
+        const auto start = Clock::now();
+        const core::Fingertip& tip = fingertips.front();
+        height.measureFingertip(subtraction, mask, tip.tip, tip.direction, tip.widthPx, evidence);
+        benchmark::DoNotOptimize(height.estimate(evidence));
+        timings.add(Clock::now() - start);
+    }
+    timings.report(state);
+}
+BENCHMARK(BM_HeightOfOneFingertip)->Unit(benchmark::kMicrosecond);
+
+void BM_TouchPipelineOneHand(benchmark::State& state) {
+    cv::setNumThreads(1);
+    const Scene& scene = oneHand();
+    core::TouchPipeline pipeline;
+    const core::PipelineSettings settings{scene.calibration, scene.pattern, 0.0};
+    // The scene's pairs over and over, their timestamps moved on each round as a camera's would be.
+    std::vector<core::FramePair> pairs = scene.pairs;
+    const std::int64_t roundUs =
+        pairs.back().latest().timestampUs - pairs.front().latest().timestampUs + 16667;
+    const auto nextRound = [&] {
+        for (core::FramePair& pair : pairs) {
+            pair.positive.timestampUs += roundUs;
+            pair.negative.timestampUs += roundUs;
+        }
+    };
+    for (const core::FramePair& pair : pairs)  // the rig prepared, the buffers sized
+        pipeline.process(pair, settings);
+    nextRound();
+    Timings timings;
+    std::size_t i = 0;
+    for (auto _ : state) {
+        const auto start = Clock::now();
+        benchmark::DoNotOptimize(pipeline.process(pairs[i], settings).contacts.size());
+        timings.add(Clock::now() - start);
+        if (++i == pairs.size()) {
+            i = 0;
+            nextRound();
+        }
+    }
+    timings.report(state);
+}
+BENCHMARK(BM_TouchPipelineOneHand)->Unit(benchmark::kMillisecond);
+
+}  // namespace
