@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core/mat.hpp>
+
 #include "core/contact.h"
 #include "core/frame.h"
 #include "io/rig_description.h"
@@ -27,6 +29,12 @@ public:
     // Ground truth of the frame `next` returned last, when the source knows it (the simulator): one entry per
     // finger the scene presents over the display, possibly none. Nothing for sources without ground truth.
     virtual std::optional<std::vector<core::FingerTruth>> truth() const { return std::nullopt; }
+
+    // Ground-truth hand mask of the frame `next` returned last, when the source knows it (the simulator, a
+    // recording with masks): CV_8UC1, camera size, 255 where the camera sees a hand; empty before the first
+    // frame. It may share its pixels with the source, so it holds only until the next call of `next`.
+    // Nothing for sources without masks.
+    virtual std::optional<cv::Mat> truthMask() const { return std::nullopt; }
 };
 
 }  // namespace everytouch::io

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <string_view>
 
 #include <opencv2/imgcodecs.hpp>
@@ -66,7 +67,21 @@ void readCsv(const std::filesystem::path& path, const std::string& header, size_
     }
 }
 
-cv::Mat readPattern(const std::filesystem::path& path, const cv::Size& projectorSize) {
+std::filesystem::path indexedPath(const std::filesystem::path& directory, const char* folder,
+                                  std::uint64_t index) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(index));
+    return directory / folder / name;
+}
+
+std::string sizeText(const cv::Size& size) {
+    return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// Reads an 8-bit single-channel image of `size` that holds only 0 and 255; `sizeName` says whose size it must
+// have.
+cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
+                        const std::string& sizeName) {
     const std::string name = path.string();
     if (!std::filesystem::is_regular_file(path))
         throw InputError(name, "", "missing");
@@ -74,25 +89,31 @@ cv::Mat readPattern(const std::filesystem::path& path, const cv::Size& projector
     if (image.empty())
         throw InputError(name, "", "not a readable image");
     if (image.type() != CV_8UC1)
-        throw InputError(name, "", "expected an 8-bit single-channel image");
-    if (image.size() != projectorSize)
         throw InputError(name, "",
-                         "expected the projector size " + std::to_string(projectorSize.width) + "x" +
-                             std::to_string(projectorSize.height));
+                         "expected an 8-bit single-channel image, found " +
+                             std::to_string(8 * image.elemSize1()) + "-bit with " +
+                             std::to_string(image.channels()) +
+                             (image.channels() == 1 ? " channel" : " channels"));
+    if (image.size() != size)
+        throw InputError(
+            name, "",
+            "expected the " + sizeName + " " + sizeText(size) + ", found " + sizeText(image.size()));
     const int nonBinary = image.total() - cv::countNonZero(image == 0) - cv::countNonZero(image == 255);
     if (nonBinary != 0)
         throw InputError(
             name, "",
             "expected only the values 0 and 255, found " + std::to_string(nonBinary) + " other pixels");
-    return image / 255;
+    return image;
 }
 
 }  // namespace
 
 std::filesystem::path Recording::framePath(const std::filesystem::path& directory, std::uint64_t index) {
-    char name[32];
-    std::snprintf(name, sizeof name, "%06llu.png", static_cast<unsigned long long>(index));
-    return directory / "frames" / name;
+    return indexedPath(directory, "frames", index);
+}
+
+std::filesystem::path Recording::maskPath(const std::filesystem::path& directory, std::uint64_t index) {
+    return indexedPath(directory, "masks", index);
 }
 
 Recording Recording::open(const std::filesystem::path& directory) {
@@ -127,7 +148,8 @@ Recording Recording::open(const std::filesystem::path& directory) {
         throw InputError(rigName, "pattern", "missing");
     if (!pattern.isString() || pattern.string().empty())
         throw InputError(rigName, "pattern", "expected a file name");
-    rig.pattern = readPattern(directory / pattern.string(), rig.calibration.projectorSize);
+    rig.pattern =
+        readBinaryImage(directory / pattern.string(), rig.calibration.projectorSize, "projector size") / 255;
 
     const std::filesystem::path framesPath = directory / "frames.csv";
     if (!std::filesystem::is_regular_file(framesPath))
@@ -154,6 +176,17 @@ Recording Recording::open(const std::filesystem::path& directory) {
                              "missing (listed in frames.csv " + where + ")");
         recording.frames_.push_back(entry);
     });
+
+    const std::filesystem::path masksPath = directory / "masks";
+    if (std::filesystem::exists(masksPath)) {
+        if (!std::filesystem::is_directory(masksPath))
+            throw InputError(masksPath.string(), "", "expected a directory of hand masks");
+        recording.hasMasks_ = true;
+        for (const FrameEntry& entry : recording.frames_)
+            if (!std::filesystem::is_regular_file(maskPath(directory, entry.index)))
+                throw InputError(maskPath(directory, entry.index).string(), "",
+                                 "missing (masks/ needs a mask for every frame in frames.csv)");
+    }
 
     const std::filesystem::path truthPath = directory / "truth.csv";
     if (std::filesystem::exists(truthPath)) {
@@ -195,14 +228,23 @@ core::Frame Recording::loadFrame(std::size_t position) const {
     return frame;
 }
 
+cv::Mat Recording::loadMask(std::size_t position) const {
+    if (!hasMasks_)
+        throw std::logic_error("loadMask: the recording has no masks");
+    return readBinaryImage(maskPath(directory_, frames_.at(position).index), rig_.calibration.cameraSize,
+                           "camera size");
+}
+
 RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig,
-                                 bool withTruth)
-    : directory_(directory) {
+                                 bool withTruth, bool withMasks)
+    : directory_(directory), cameraSize_(rig.calibration.cameraSize), withMasks_(withMasks) {
     std::error_code error;
     if (std::filesystem::exists(directory) && !std::filesystem::is_empty(directory))
         throw InputError(directory.string(), "", "exists and is not empty; choose a new recording directory");
     if (!std::filesystem::create_directories(directory / "frames", error) && error)
         throw InputError(directory.string(), "", "cannot be created: " + error.message());
+    if (withMasks && !std::filesystem::create_directory(directory / "masks", error) && error)
+        throw InputError((directory / "masks").string(), "", "cannot be created: " + error.message());
 
     cv::FileStorage storage(".yml",
                             cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
@@ -239,6 +281,16 @@ void RecordingWriter::addTruth(const std::vector<core::FingerTruth>& fingers) {
                       finger.heightMm);
         truthCsv_ << line;
     }
+}
+
+void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
+    if (!withMasks_)
+        throw std::logic_error("addMask: the recording was started without masks");
+    if (mask.type() != CV_8UC1 || mask.size() != cameraSize_)
+        throw std::invalid_argument("addMask: expected an 8-bit single-channel mask of the camera size");
+    const std::filesystem::path path = Recording::maskPath(directory_, frameIndex);
+    if (!cv::imwrite(path.string(), mask))
+        throw InputError(path.string(), "", "cannot be written");
 }
 
 void RecordingWriter::flush() {

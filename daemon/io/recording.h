@@ -34,12 +34,20 @@ public:
     const std::vector<FrameEntry>& frames() const { return frames_; }
     const std::vector<core::FingerTruth>& truth() const { return truth_; }  // empty without truth.csv
     bool hasTruth() const { return hasTruth_; }
+    // The recording has masks/, and then a mask file for every frame.
+    bool hasMasks() const { return hasMasks_; }
 
     // Reads frame number `position` (0 .. frames().size()-1); throws InputError if the image is unreadable or
     // does not match camera_size.
     core::Frame loadFrame(std::size_t position) const;
 
+    // Reads the ground-truth hand mask of frame number `position` (CV_8UC1, camera size, 255 where the camera
+    // sees a hand); only when hasMasks(). Throws InputError if the image is unreadable, not 8-bit single
+    // channel, not of camera_size or holds values other than 0 and 255.
+    cv::Mat loadMask(std::size_t position) const;
+
     static std::filesystem::path framePath(const std::filesystem::path& directory, std::uint64_t index);
+    static std::filesystem::path maskPath(const std::filesystem::path& directory, std::uint64_t index);
 
 private:
     std::filesystem::path directory_;
@@ -47,19 +55,27 @@ private:
     std::vector<FrameEntry> frames_;
     std::vector<core::FingerTruth> truth_;
     bool hasTruth_ = false;
+    bool hasMasks_ = false;
 };
 
-// Writes a recording directory from any rig. The directory must not exist or be empty.
+// Writes a recording directory from any rig. The directory must not exist or be empty. With truth, truth.csv
+// takes the fingers of every frame; with masks, masks/ takes the hand mask of every frame.
 class RecordingWriter {
 public:
-    RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig, bool withTruth);
+    RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig, bool withTruth,
+                    bool withMasks = false);
 
     void addFrame(const core::Frame& frame);
     void addTruth(const std::vector<core::FingerTruth>& fingers);
+    // The hand mask of frame `frameIndex`: CV_8UC1, camera size, 0 and 255. Throws std::logic_error for a
+    // writer without masks and std::invalid_argument for another type or size.
+    void addMask(std::uint64_t frameIndex, const cv::Mat& mask);
     void flush();
 
 private:
     std::filesystem::path directory_;
+    cv::Size cameraSize_;
+    bool withMasks_;
     std::ofstream framesCsv_;
     std::ofstream truthCsv_;
 };

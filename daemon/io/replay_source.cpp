@@ -22,4 +22,10 @@ std::optional<core::Frame> ReplaySource::next() {
     return frame;
 }
 
+std::optional<cv::Mat> ReplaySource::truthMask() const {
+    if (!recording_.hasMasks())
+        return std::nullopt;
+    return position_ == 0 ? cv::Mat() : recording_.loadMask(position_ - 1);
+}
+
 }  // namespace everytouch::io

@@ -17,6 +17,8 @@ public:
     std::optional<core::Frame> next() override;
     std::optional<RigDescription> rig() const override { return recording_.rig(); }
     std::string describe() const override { return "replay of " + directory_.string(); }
+    // Read from the recording on each call, so a replay nobody asks for masks reads none.
+    std::optional<cv::Mat> truthMask() const override;
 
     const Recording& recording() const { return recording_; }
 

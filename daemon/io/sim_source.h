@@ -26,6 +26,8 @@ public:
     std::optional<RigDescription> rig() const override;
     std::string describe() const override;
     std::optional<std::vector<core::FingerTruth>> truth() const override;
+    // The renderer's mask itself, rewritten by the next frame.
+    std::optional<cv::Mat> truthMask() const override { return truth_.handMask; }
 
     // Everything the renderer knows about the last frame: every fingertip, the hand mask, visible heights.
     const sim::FrameTruth& frameTruth() const { return truth_; }

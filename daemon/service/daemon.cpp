@@ -116,8 +116,9 @@ int Daemon::run() {
     if (!options_.recordDir.empty()) {
         if (!rig)
             throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
-        recorder_ =
-            std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, source_->truth().has_value());
+        const bool withTruth = source_->truth().has_value();
+        const bool withMasks = source_->truthMask().has_value();
+        recorder_ = std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, withTruth, withMasks);
     }
     if (const int r = startEventLoop(); r < 0)
         throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");

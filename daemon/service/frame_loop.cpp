@@ -112,6 +112,8 @@ void FrameLoop::runCamera() {
                 recorder_->addFrame(item.frame);
                 if (const auto truth = source_.truth())
                     recorder_->addTruth(*truth);
+                if (const auto mask = source_.truthMask())
+                    recorder_->addMask(item.frame.index, *mask);
             }
         } catch (const std::exception& error) {
             fail(std::string("camera: ") + error.what());

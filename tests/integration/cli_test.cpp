@@ -44,8 +44,13 @@ TEST(Everytouchd, MissingRecordingIsReportedByPath) {
 TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
     test::TempDir dir;
     const io::RigDescription rig = test::paperLikeRig();
+    const auto maskOf = [&](std::uint64_t i) {
+        cv::Mat mask(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(0));
+        mask(cv::Rect(50 * static_cast<int>(i), 100, 60, 30)).setTo(255);
+        return mask;
+    };
     {
-        io::RecordingWriter writer(dir / "in", rig, false);
+        io::RecordingWriter writer(dir / "in", rig, false, true);
         for (std::uint64_t i = 0; i < 6; ++i) {
             core::Frame frame;
             frame.index = i;
@@ -54,6 +59,7 @@ TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
             frame.image =
                 cv::Mat(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(static_cast<double>(40 * i)));
             writer.addFrame(frame);
+            writer.addMask(i, maskOf(i));
         }
     }
     const test::ProcessResult result = test::runProcess(
@@ -66,6 +72,8 @@ TEST(Everytouchd, ReplaysARecordingAndRecordsItAgain) {
     EXPECT_EQ(cv::norm(again.loadFrame(4).image,
                        cv::Mat(rig.calibration.cameraSize, CV_8UC1, cv::Scalar(160)), cv::NORM_INF),
               0.0);
+    ASSERT_TRUE(again.hasMasks()) << "the ground-truth masks are kept";
+    EXPECT_EQ(cv::norm(again.loadMask(4), maskOf(4), cv::NORM_INF), 0.0);
     EXPECT_TRUE(io::readTouchLog(dir / "touches.jsonl").empty());
 }
 
@@ -85,6 +93,9 @@ TEST(Everytouchd, RecordsTheSimulatedRigWithGroundTruth) {
     EXPECT_EQ(recording.frames()[1].polarity, core::Polarity::Negative);
     EXPECT_EQ(recording.truth().front().frameIndex, 360u);
     EXPECT_EQ(recording.loadFrame(0).image.type(), CV_8UC3);
+    ASSERT_TRUE(recording.hasMasks());  // and so a mask file for every frame, masks/000360.png on
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir / "rec" / "masks" / "000383.png"));
+    EXPECT_GT(cv::countNonZero(recording.loadMask(23)), 0) << "the pointing hand";
 }
 
 TEST(Everytouchd, BadSimulatorOptionIsAUsageError) {

@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "io/input_error.h"
 #include "support/file_contents.h"
@@ -32,15 +33,25 @@ core::Frame makeFrame(std::uint64_t index, const cv::Size& size) {
     return frame;
 }
 
+// A hand-like blob that moves from frame to frame.
+cv::Mat makeMask(std::uint64_t index, const cv::Size& size) {
+    cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
+    cv::ellipse(mask, cv::Point(100 + 40 * static_cast<int>(index), 200), cv::Size(60, 25), 30.0, 0.0, 360.0,
+                cv::Scalar(255), cv::FILLED);
+    return mask;
+}
+
 class RecordingTest : public ::testing::Test {
 protected:
     void SetUp() override {
         rig_ = test::paperLikeRig();
-        RecordingWriter writer(dir_.path(), rig_, true);
+        RecordingWriter writer(dir_.path(), rig_, true, true);
         for (std::uint64_t i = 0; i < 4; ++i) {
             frames_.push_back(makeFrame(i, rig_.calibration.cameraSize));
+            masks_.push_back(makeMask(i, rig_.calibration.cameraSize));
             writer.addFrame(frames_.back());
             writer.addTruth({{i, 7, 100.5 + i, 200.25, i == 3 ? 0.0 : 4.5}});
+            writer.addMask(i, masks_.back());
         }
         writer.flush();
     }
@@ -67,7 +78,20 @@ protected:
     test::TempDir dir_;
     RigDescription rig_;
     std::vector<core::Frame> frames_;
+    std::vector<cv::Mat> masks_;
 };
+
+// What reading mask number `position` of the recording in `directory` complains about.
+std::string maskComplaint(const std::filesystem::path& directory, std::size_t position) {
+    const Recording recording = Recording::open(directory);
+    try {
+        recording.loadMask(position);
+    } catch (const InputError& error) {
+        return error.what();
+    }
+    ADD_FAILURE() << "the mask was accepted";
+    return {};
+}
 
 TEST_F(RecordingTest, RoundTripGivesBackRigFramesAndTruth) {
     const Recording recording = Recording::open(dir_.path());
@@ -87,6 +111,86 @@ TEST_F(RecordingTest, RoundTripGivesBackRigFramesAndTruth) {
     ASSERT_EQ(recording.truth().size(), 4u);
     EXPECT_EQ(recording.truth()[1], (core::FingerTruth{1, 7, 101.5, 200.25, 4.5}));
     EXPECT_EQ(recording.truth()[3].heightMm, 0.0);
+    ASSERT_TRUE(recording.hasMasks());
+    for (std::size_t i = 0; i < 4; ++i) {
+        const cv::Mat mask = recording.loadMask(i);
+        EXPECT_EQ(mask.type(), CV_8UC1);
+        EXPECT_EQ(cv::norm(mask, masks_[i], cv::NORM_INF), 0.0) << "masks must be lossless";
+    }
+    EXPECT_TRUE(std::filesystem::is_regular_file(dir_ / "masks" / "000003.png"));
+}
+
+TEST_F(RecordingTest, RecordingWithoutMasksOpens) {
+    std::filesystem::remove_all(dir_ / "masks");
+    const Recording recording = Recording::open(dir_.path());
+    EXPECT_FALSE(recording.hasMasks());
+    EXPECT_EQ(recording.frames().size(), 4u);
+    EXPECT_THROW(recording.loadMask(0), std::logic_error);
+}
+
+TEST_F(RecordingTest, WriterWithoutMasksWritesNoMasksDirectory) {
+    test::TempDir other;
+    RecordingWriter writer(other / "rec", rig_, false);
+    writer.addFrame(frames_[0]);
+    EXPECT_THROW(writer.addMask(0, masks_[0]), std::logic_error);
+    writer.flush();
+    EXPECT_FALSE(std::filesystem::exists(other / "rec" / "masks"));
+    EXPECT_FALSE(Recording::open(other / "rec").hasMasks());
+}
+
+TEST_F(RecordingTest, WriterRefusesAMaskOfAnotherSizeOrType) {
+    test::TempDir other;
+    RecordingWriter writer(other / "rec", rig_, false, true);
+    writer.addFrame(frames_[0]);
+    EXPECT_THROW(writer.addMask(0, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
+    EXPECT_THROW(writer.addMask(0, cv::Mat(rig_.calibration.cameraSize, CV_8UC3, cv::Scalar::all(0))),
+                 std::invalid_argument);
+}
+
+TEST_F(RecordingTest, RejectsMissingMaskFile) {
+    std::filesystem::remove(Recording::maskPath(dir_.path(), 2));
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("masks/000002.png"), HasSubstr("missing")));
+}
+
+TEST_F(RecordingTest, RejectsMasksThatAreNotADirectory) {
+    std::filesystem::remove_all(dir_ / "masks");
+    writeText(dir_ / "masks", "not a directory\n");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr("masks"), HasSubstr("directory")));
+}
+
+TEST_F(RecordingTest, MaskOfWrongSizeIsRejectedWhenRead) {
+    cv::imwrite(Recording::maskPath(dir_.path(), 1).string(), cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)));
+    EXPECT_THAT(
+        maskComplaint(dir_.path(), 1),
+        AllOf(HasSubstr("masks/000001.png"), HasSubstr("camera size 648x488"), HasSubstr("found 10x10")));
+}
+
+TEST_F(RecordingTest, MaskOfWrongTypeIsRejectedWhenRead) {
+    cv::Mat wide;
+    masks_[1].convertTo(wide, CV_16UC1);
+    ASSERT_TRUE(cv::imwrite(Recording::maskPath(dir_.path(), 1).string(), wide));
+    EXPECT_THAT(maskComplaint(dir_.path(), 1),
+                AllOf(HasSubstr("masks/000001.png"), HasSubstr("8-bit single-channel"), HasSubstr("16-bit")));
+    cv::Mat colour;
+    cv::cvtColor(masks_[2], colour, cv::COLOR_GRAY2BGR);
+    ASSERT_TRUE(cv::imwrite(Recording::maskPath(dir_.path(), 2).string(), colour));
+    EXPECT_THAT(
+        maskComplaint(dir_.path(), 2),
+        AllOf(HasSubstr("masks/000002.png"), HasSubstr("8-bit single-channel"), HasSubstr("3 channels")));
+}
+
+TEST_F(RecordingTest, MaskWithValuesOtherThan0And255IsRejectedWhenRead) {
+    cv::Mat blurred;
+    cv::GaussianBlur(masks_[3], blurred, cv::Size(5, 5), 0.0);
+    ASSERT_TRUE(cv::imwrite(Recording::maskPath(dir_.path(), 3).string(), blurred));
+    EXPECT_THAT(maskComplaint(dir_.path(), 3),
+                AllOf(HasSubstr("masks/000003.png"), HasSubstr("only the values 0 and 255")));
+}
+
+TEST_F(RecordingTest, UnreadableMaskIsRejectedWhenRead) {
+    writeText(Recording::maskPath(dir_.path(), 0), "not a png");
+    EXPECT_THAT(maskComplaint(dir_.path(), 0),
+                AllOf(HasSubstr("masks/000000.png"), HasSubstr("not a readable")));
 }
 
 TEST_F(RecordingTest, PatternFileUses0And255) {

@@ -5,7 +5,10 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "core/camera_model.h"
 #include "io/input_error.h"
+#include "sim/sim_options.h"
+#include "sim/simulator.h"
 #include "support/temp_dir.h"
 
 namespace everytouch::io {
@@ -55,6 +58,56 @@ TEST(SimSource, ReportsTheTruthOfThePresentedFingers) {
     EXPECT_EQ(truth->front().heightMm, 0.0);
     EXPECT_GT(truth->front().x, 0.0);
     EXPECT_LT(truth->front().x, 640.0);
+}
+
+TEST(SimSource, HandMaskIsTheRenderersAndCoversTheTouchingFingers) {
+    // The first tap of grid35 touches between 1.57 and 1.77 s and lasts at least 0.18 s, whatever the seed.
+    const RigSpec spec = RigSpec::parse("sim:grid35,seed=3,start=1.6,duration=0.2");
+    SimSource source(spec, false);
+    ASSERT_TRUE(source.truthMask());
+    EXPECT_TRUE(source.truthMask()->empty()) << "no frame yet";
+
+    // The same rig rendered on its own.
+    sim::SimParameters parameters;
+    parameters.scenario = spec.target;
+    for (const auto& [key, value] : spec.options)
+        ASSERT_EQ(sim::applyOption(parameters, key, value), std::nullopt) << key;
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+
+    const core::Calibration calibration = source.rig()->calibration;
+    const Eigen::Matrix3d displayToCamera = calibration.cameraToDisplayHomography().inverse();
+    const core::CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    const cv::Rect image(cv::Point(0, 0), calibration.cameraSize);
+    int touches = 0;
+    while (const std::optional<core::Frame> frame = source.next()) {
+        const std::optional<cv::Mat> mask = source.truthMask();
+        ASSERT_TRUE(mask);
+        ASSERT_EQ(mask->type(), CV_8UC1);
+        ASSERT_EQ(mask->size(), calibration.cameraSize);
+        core::Frame alone;
+        sim::FrameTruth truth;
+        simulator.render(frame->index, alone, truth);
+        EXPECT_EQ(cv::norm(*mask, truth.handMask, cv::NORM_INF), 0.0) << "frame " << frame->index;
+        EXPECT_EQ(cv::countNonZero(*mask == 0) + cv::countNonZero(*mask == 255),
+                  static_cast<int>(mask->total()));
+        // A touching finger seen from above covers its own contact point.
+        const std::optional<std::vector<core::FingerTruth>> fingers = source.truth();
+        ASSERT_TRUE(fingers);
+        for (const core::FingerTruth& finger : *fingers) {
+            if (finger.heightMm != 0.0)
+                continue;
+            const Eigen::Vector2d undistorted =
+                (displayToCamera * Eigen::Vector3d(finger.x, finger.y, 1.0)).hnormalized();
+            const Eigen::Vector2d raw = camera.distortPixel(undistorted);
+            const cv::Point contact(static_cast<int>(raw.x()), static_cast<int>(raw.y()));
+            ASSERT_TRUE(image.contains(contact));
+            EXPECT_GT(cv::countNonZero((*mask)(cv::Rect(contact - cv::Point(4, 4), cv::Size(9, 9)) & image)),
+                      0)
+                << "frame " << frame->index << " finger " << finger.id;
+            ++touches;
+        }
+    }
+    EXPECT_GT(touches, 0);
 }
 
 TEST(SimSource, StartsIntoTheSession) {
