@@ -9,7 +9,7 @@
 
 namespace everytouch::core {
 
-// The calibration model of the projector-camera-table rig (architecture.md, "Geometry and calibration
+// The calibration model of the projector-camera-table rig (docs/architecture.md, "Geometry and calibration
 // model"). Table frame: x, y on the table in millimetres, z up. Every homography the pipeline needs is
 // derived from it; camera pixels are undistorted pixels throughout.
 struct Calibration {

@@ -64,6 +64,9 @@ constexpr float kFallbackNoiseVariance = 4.0f;
 // How many standard deviations of chance correlation the table's expected correlation must exceed for the
 // code to tell the table from something else.
 constexpr float kSignificance = 3.0f;
+// The brightest code pixel shows twice the code's mean (half the bits are 1); noise and a brighter patch of
+// table add to that. Beyond this many times the table's mean, S is no longer code.
+constexpr float kMotionAmplitudes = 3.0f;
 
 }  // namespace
 
@@ -90,24 +93,30 @@ std::optional<std::string> SegmentationOptions::validate() const {
         return "cameraBlurPx: must be a non-negative number of pixels";
     if (!(fingerWidthMm > 0.0) || !std::isfinite(fingerWidthMm))
         return "fingerWidthMm: must be a positive number of millimetres";
+    if (!(minElevationMm >= 0.0 && minElevationMm < elevation.maxHeightMm))
+        return "minElevationMm: must be from 0 to the highest elevation measured";
     if (closingRadiusPx < 0)
         return "closingRadiusPx: must not be negative";
     if (auto problem = saliency.validate())
         return "saliency." + *problem;
     if (auto problem = meanShift.validate())
         return "meanShift." + *problem;
+    if (auto problem = elevation.validate())
+        return "elevation." + *problem;
     if (auto problem = confidence.validate())
         return "confidence." + *problem;
     return std::nullopt;
 }
 
-HandSegmenter::HandSegmenter(const SegmentationOptions& options) : options_(options) {
+HandSegmenter::HandSegmenter(const SegmentationOptions& options)
+    : options_(options), elevation_(options.elevation) {
     if (auto problem = options.validate())
         throw std::invalid_argument("segmentation options: " + *problem);
 }
 
 void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& pattern) {
     tableCode_ = predictTableCode(calibration, pattern, options_.cameraBlurPx);
+    elevation_.setRig(calibration, pattern);
     evidence_ = CodeEvidence{};
     evidence_.blockPx = options_.blockPx;
     evidence_.windowBlocks = options_.windowBlocks;
@@ -173,7 +182,7 @@ void HandSegmenter::segment(const cv::Mat& texture, const cv::Mat& subtraction, 
 void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
     measureCodeEvidence(subtraction, tableCode_, evidence_);
     classifyBlocks();
-    keepLargeComponents();
+    keepHandComponents(subtraction);
     mask.create(texture.size(), CV_8UC1);
     mask.setTo(0);
     measureBlockColours(texture);
@@ -241,10 +250,29 @@ void HandSegmenter::classifyBlocks() {
                 c = Candidate;
         }
     const float tableAmplitude = quantile(values_, 0.5);
+    tableAmplitude_ = tableAmplitude;
     litAmplitude_ = zeroLevel + static_cast<float>(options_.litFraction) * (tableAmplitude - zeroLevel);
 }
 
-void HandSegmenter::keepLargeComponents() {
+bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
+    // The component's pixels, at most about kMaxPixels of them (a sample of its blocks).
+    constexpr int kMaxPixels = 1600;
+    const int blockPx = options_.blockPx, cols = blockClass_.cols;
+    const int perBlock = blockPx * blockPx;
+    const int blockStride = std::max(1, size * perBlock / kMaxPixels);
+    elevation_.clearPixels();
+    for (int k = 0; k < size; k += blockStride) {
+        const int y0 = component_[k] / cols * blockPx, x0 = component_[k] % cols * blockPx;
+        for (int y = y0; y < y0 + blockPx; ++y)
+            for (int x = x0; x < x0 + blockPx; ++x)
+                elevation_.addPixel(subtraction, x, y);
+    }
+    elevation_.measurePixels(elevationEvidence_);
+    const HeightEstimate height = elevation_.estimate(elevationEvidence_);
+    return height.valid && height.heightMm < options_.minElevationMm;
+}
+
+void HandSegmenter::keepHandComponents(const cv::Mat& subtraction) {
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     const double blockMm = options_.blockPx / pixelsPerMm_;
     const double fingerBlocks = options_.fingerWidthMm / blockMm;
@@ -275,7 +303,7 @@ void HandSegmenter::keepLargeComponents() {
                     }
                 }
         }
-        if (size < minBlocks)
+        if (size < minBlocks || liesOnTable(subtraction, size))
             for (int k = 0; k < size; ++k)
                 classes[component_[k]] = Unlit;
     }
@@ -398,8 +426,12 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             }
             // A pixel in the hand's own shadow gets no light from the projector, and no code: whatever its
             // colour, it is not the hand (a hand over black content loses its outline pixels here too).
-            constexpr int kLitReach = 2;  // the lit test averages S over 5 x 5 pixels
-            const int litSum = static_cast<int>(std::ceil(25.0f * litAmplitude_));
+            constexpr int kLitReach = 1;  // the lit test averages S over 3 x 3 pixels
+            // Beyond the brightest code the table shows, S is not code but the scene changing between the two
+            // frames: a moving edge or a shadow sweeping over the table. It says nothing about light.
+            const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
+            const int litSum =
+                static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));
             for (int y = block.y; y < block.y + blockPx; ++y) {
                 const uchar* row = texture.ptr<uchar>(y);
                 uchar* out = mask.ptr<uchar>(y);
@@ -407,8 +439,10 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     int localSum = 0;
                     for (int dy = -kLitReach; dy <= kLitReach; ++dy) {
                         const short* s = subtraction.ptr<short>(std::clamp(y + dy, 0, subtraction.rows - 1));
-                        for (int dx = -kLitReach; dx <= kLitReach; ++dx)
-                            localSum += s[std::clamp(x + dx, 0, subtraction.cols - 1)];
+                        for (int dx = -kLitReach; dx <= kLitReach; ++dx) {
+                            const int value = s[std::clamp(x + dx, 0, subtraction.cols - 1)];
+                            localSum += value <= motionLevel ? value : 0;
+                        }
                     }
                     if (c != Grown && localSum < litSum) {
                         out[x] = 0;

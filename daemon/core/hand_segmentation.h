@@ -11,6 +11,7 @@
 #include "core/mean_shift_segmentation.h"
 #include "core/saliency.h"
 #include "core/segment_confidence.h"
+#include "core/surface_height.h"
 #include "core/table_code.h"
 
 namespace everytouch::core {
@@ -45,6 +46,11 @@ struct SegmentationOptions {
     double cameraBlurPx = 0.5;
     // A finger is this wide (mm); a region narrower than half a finger's area is noise, not a hand.
     double fingerWidthMm = 14.0;
+    // Whatever of a hand the camera sees from above lies at least this high (mm): fingers are 10 mm thick
+    // or more. A region whose code puts it lower is on the table: printed text or a stain that changed the
+    // code's look, not a hand.
+    double minElevationMm = 4.0;
+    HeightOptions elevation;  // how the height of a region is measured
 
     // The paper's method.
     SaliencyOptions saliency;
@@ -86,7 +92,8 @@ private:
     void segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
     void segmentAsPaper(const cv::Mat& texture, cv::Mat& mask);
     void classifyBlocks();
-    void keepLargeComponents();
+    void keepHandComponents(const cv::Mat& subtraction);
+    bool liesOnTable(const cv::Mat& subtraction, int size);
     void measureBlockColours(const cv::Mat& texture);
     void growIntoFaintBlocks();
     void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
@@ -98,7 +105,8 @@ private:
     cv::Mat displayBlocks_;  // CV_8UC1, block grid: 1 where the whole window lies on the display
     double pixelsPerMm_ = 1.0;
     float litAmplitude_ = 0.0f;
-    float noiseVariance_ = 0.0f;  // of S where only noise is seen (DN^2)
+    float tableAmplitude_ = 0.0f;  // mean S on the table in the last frame
+    float noiseVariance_ = 0.0f;   // of S where only noise is seen (DN^2)
     cv::Mat blockExpected_;  // CV_32FC1, block grid: the table code's correlation if the table were there  //
                              // mean S below which a surface gets too little projector light to judge
 
@@ -108,6 +116,8 @@ private:
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
+    SurfaceHeight elevation_;
+    HeightEvidence elevationEvidence_;
 
     cv::Mat gray3_;
     SaliencyScratch saliencyScratch_;

@@ -12,8 +12,8 @@ namespace everytouch::io {
 inline constexpr const char* kCalibrationFormat = "everytouch-calibration";
 inline constexpr int kCalibrationVersion = 1;
 
-// Reads a calibration file (OpenCV FileStorage YAML, architecture.md). Throws InputError naming the file and
-// the field on any problem; returns only a complete, validated calibration.
+// Reads a calibration file (OpenCV FileStorage YAML, docs/architecture.md). Throws InputError naming the file
+// and the field on any problem; returns only a complete, validated calibration.
 core::Calibration readCalibrationFile(const std::filesystem::path& path);
 
 // Writes the calibration atomically: a temporary file beside `path`, fsync, rename. The old file stays intact

@@ -23,8 +23,8 @@ struct FrameEntry {
     core::Polarity polarity = core::Polarity::Positive;
 };
 
-// A recording directory (architecture.md, "Recording"). Opening checks every file it names, so a recording
-// either opens completely or not at all; frame images are read on demand.
+// A recording directory (docs/architecture.md, "Recording"). Opening checks every file it names, so a
+// recording either opens completely or not at all; frame images are read on demand.
 class Recording {
 public:
     // Throws InputError naming the file and the field or line at fault.

@@ -11,7 +11,7 @@
 
 namespace everytouch::io {
 
-// One line of a touch log (architecture.md, "Touch log").
+// One line of a touch log (docs/architecture.md, "Touch log").
 struct TouchLogEntry {
     std::uint64_t index = 0;
     std::int64_t timestampUs = 0;

@@ -14,7 +14,7 @@ namespace everytouch::service {
 
 class Daemon;
 
-// The daemon's face on the system bus: the org.everytouch.Daemon1 object (architecture.md, "D-Bus
+// The daemon's face on the system bus: the org.everytouch.Daemon1 object (docs/architecture.md, "D-Bus
 // interface"). It parses arguments, checks who may change state, and turns the daemon's BusErrors into error
 // replies. Main thread only.
 class BusService {

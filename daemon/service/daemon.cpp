@@ -1,17 +1,13 @@
 #include "service/daemon.h"
 
-#include <fcntl.h>
 #include <signal.h>
 #include <systemd/sd-daemon.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
-#include <mutex>
 #include <system_error>
 
 #include "io/input_error.h"
@@ -33,15 +29,6 @@ constexpr std::size_t kQueueFrames = 4;
 // Contacts signals at most this often: enough for a tool that draws them, far below the camera rate.
 constexpr auto kContactsSignalInterval = std::chrono::milliseconds(33);
 constexpr std::uint64_t kStatusIntervalUsec = 5'000'000;
-// How long a Snapshot waits for a frame pair before it reports that the camera delivers none.
-constexpr std::uint64_t kSnapshotTimeoutUsec = 3'000'000;
-// How long a Snapshot waits for the receiving end of its descriptor to take the PNG.
-constexpr std::chrono::milliseconds kSnapshotWriteTimeout{3000};
-
-// How long a calibration step waits for its frame pairs: a fixed allowance plus a generous time per pair.
-std::chrono::milliseconds captureTimeout(std::size_t pairs) {
-    return std::chrono::milliseconds(5000 + 100 * static_cast<long>(pairs));
-}
 
 std::string formatDouble(const char* format, double value) {
     char text[64];
@@ -207,6 +194,11 @@ void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
             } catch (const std::exception& error) {
                 ET_LOG(Error) << "virtual touchscreen: " << error.what() << "; it keeps its previous size";
             }
+        });
+    snapshots_ = std::make_unique<SnapshotRequests>(
+        event_.get(), *loop_, inbox_, [this](SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
+            std::uint64_t contactsVersion = 0;
+            renderSnapshot(kind, pair, store_->active(), loop_->contacts(contactsVersion), image);
         });
     loop_->start();
 }
@@ -396,54 +388,17 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
             bus::kErrorCalibrationFailed,
             "The projector's size is unknown: this rig has no projector output and no calibration");
 
-    calibration_ = std::make_unique<CalibrationRun>();
-    CalibrationRun* run = calibration_.get();
     const cv::Size projectorSize = !projectorSize_.empty() ? projectorSize_ : store_->active()->projectorSize;
-    run->thread =
-        std::thread([this, run, steps = std::move(*steps), options, start = store_->active(), projectorSize] {
-            const CaptureFunction capture = [this, run](std::size_t pairs) {
-                struct Handover {
-                    std::mutex mutex;
-                    std::condition_variable arrived;
-                    std::optional<std::vector<core::FramePair>> pairs;
-                };
-                auto handover = std::make_shared<Handover>();
-                const FrameTap::Ticket ticket =
-                    loop_->tap().request(pairs, [handover](std::vector<core::FramePair>&& captured) {
-                        std::lock_guard lock(handover->mutex);
-                        handover->pairs = std::move(captured);
-                        handover->arrived.notify_all();
-                    });
-                const auto deadline = Clock::now() + captureTimeout(pairs);
-                std::unique_lock lock(handover->mutex);
-                while (!handover->pairs && !run->cancelled && Clock::now() < deadline)
-                    handover->arrived.wait_for(lock, std::chrono::milliseconds(100));
-                if (!handover->pairs)
-                    loop_->tap().cancel(ticket);
-                return std::move(handover->pairs);
-            };
-            const ProgressFunction progress = [this](const std::string& step, double fraction,
-                                                     const std::string& message) {
-                inbox_.post([this, step, fraction, message] {
-                    if (bus_)
-                        bus_->calibrationProgress(step, fraction, message);
-                });
-            };
-            CalibrationOutcome outcome;
-            try {
-                // Whatever ends the job, the desktop comes back when the lease goes.
-                io::ProjectorLease lease(projector_.get());
-                const ShowFunction show = [this, &lease, &capture](const cv::Mat& projectorImage) {
-                    if (!projector_)
-                        return;
-                    lease.show(projectorImage);
-                    // Frames exposed before the image changed may still be queued, and one may be under way.
-                    capture(kQueueFrames + 2);
-                };
-                outcome = runCalibration(steps, options, start, projectorSize, capture, show, progress);
-            } catch (const std::exception& error) {
-                outcome.message = error.what();
-            }
+    calibration_ = std::make_unique<CalibrationRunner>(
+        loop_->tap(), projector_.get(), kQueueFrames,
+        CalibrationJob{std::move(*steps), options, store_->active(), projectorSize},
+        [this](const std::string& step, double fraction, const std::string& message) {
+            inbox_.post([this, step, fraction, message] {
+                if (bus_)
+                    bus_->calibrationProgress(step, fraction, message);
+            });
+        },
+        [this](const CalibrationOutcome& outcome) {
             inbox_.post([this, outcome] { finishCalibration(outcome); });
         });
     refreshState();
@@ -452,7 +407,6 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
 void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
     if (!calibration_)
         return;
-    calibration_->thread.join();
     calibration_.reset();
     if (outcome.ok) {
         store_->activate(*outcome.calibration);
@@ -526,76 +480,26 @@ void Daemon::snapshot(sd_bus_message* call, std::string_view what, int fd) {
         throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Unknown snapshot \"" + std::string(what) +
                                                       "\"; expected " + kSnapshotKinds + " (later also " +
                                                       kSnapshotKindsNeedingDetection + ")");
-    const int flags = ::fcntl(fd, F_GETFL);
-    if (flags < 0 || (flags & O_ACCMODE) == O_RDONLY)
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "The file descriptor is not open for writing");
-    if (loop_->finished())
-        throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
-    io::UniqueFd copy(::fcntl(fd, F_DUPFD_CLOEXEC, 3));
-    if (!copy)
-        throw BusError(SD_BUS_ERROR_FAILED,
-                       std::string("Cannot keep the file descriptor: ") + std::strerror(errno));
-
-    const std::uint64_t id = nextSnapshotId_++;
-    PendingSnapshot& pending = snapshots_[id];
-    pending.daemon = this;
-    pending.id = id;
-    pending.call.reset(sd_bus_message_ref(call));
-    pending.fd = std::move(copy);
-    pending.kind = *kind;
-    sd_event_source* timeout = nullptr;
-    if (const int r = sd_event_add_time_relative(event_.get(), &timeout, CLOCK_MONOTONIC,
-                                                 kSnapshotTimeoutUsec, 0, onSnapshotTimeout, &pending);
-        r < 0) {
-        snapshots_.erase(id);
-        throw BusError(SD_BUS_ERROR_FAILED, std::string("Cannot set a timeout: ") + std::strerror(-r));
-    }
-    pending.timeout.reset(timeout);
-    pending.ticket = loop_->tap().request(1, [this, id](std::vector<core::FramePair>&& pairs) {
-        inbox_.post([this, id, pair = std::move(pairs.front())] { completeSnapshot(id, pair); });
-    });
-}
-
-void Daemon::completeSnapshot(std::uint64_t id, const core::FramePair& pair) {
-    const auto it = snapshots_.find(id);
-    if (it == snapshots_.end())
-        return;
-    cv::Mat image;
-    std::uint64_t contactsVersion = 0;
-    renderSnapshot(it->second.kind, pair, store_->active(), loop_->contacts(contactsVersion), image);
-    const int r = writeAllWithin(it->second.fd.get(), encodePng(image), kSnapshotWriteTimeout);
-    if (r < 0) {
-        failSnapshot(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-r));
-        return;
-    }
-    if (bus_)
-        bus_->reply(it->second.call.get());
-    snapshots_.erase(it);
-}
-
-void Daemon::failSnapshot(std::uint64_t id, const char* errorName, const std::string& message) {
-    const auto it = snapshots_.find(id);
-    if (it == snapshots_.end())
-        return;
-    if (loop_)
-        loop_->tap().cancel(it->second.ticket);
-    if (bus_)
-        bus_->replyError(it->second.call.get(), errorName, message);
-    snapshots_.erase(it);
+    // Either answer may come after this call returned, so both keep the call alive.
+    const std::shared_ptr<sd_bus_message> held(sd_bus_message_ref(call), sd_bus_message_unref);
+    snapshots_->add(*kind, fd,
+                    SnapshotReply{[this, held] {
+                                      if (bus_)
+                                          bus_->reply(held.get());
+                                  },
+                                  [this, held](const char* errorName, const std::string& message) {
+                                      if (bus_)
+                                          bus_->replyError(held.get(), errorName, message);
+                                  }});
 }
 
 void Daemon::shutDown() {
     if (!loop_)
         return;
     sd_notify(0, "STOPPING=1");
-    if (calibration_) {
-        calibration_->cancelled = true;
-        calibration_->thread.join();
-        calibration_.reset();
-    }
+    calibration_.reset();  // cancels a job still running and waits for its thread
     loop_->stop();
-    while (!snapshots_.empty())
-        failSnapshot(snapshots_.begin()->first, bus::kErrorNoCamera, "everytouchd is stopping");
+    snapshots_->failAll(bus::kErrorNoCamera, "everytouchd is stopping");
     bus_.reset();
     const LoopStatistics statistics = loop_->statistics();
     ET_LOG(Info) << "processed " << statistics.frames << " frames (" << statistics.pairs << " pairs) in "
@@ -603,6 +507,7 @@ void Daemon::shutDown() {
                  << " dropped; all contacts released";
     ET_LOG(Notice) << "touch detection is not part of this build yet: frames are paired and recorded, no "
                       "contacts are reported";
+    snapshots_.reset();
     loop_.reset();
 }
 
@@ -651,18 +556,6 @@ int Daemon::onStatusTimer(sd_event_source* source, uint64_t, void* userdata) noe
 int Daemon::onContactsTimer(sd_event_source*, uint64_t, void* userdata) noexcept {
     try {
         static_cast<Daemon*>(userdata)->emitContacts();
-    } catch (const std::exception& error) {
-        ET_LOG(Error) << "internal error: " << error.what();
-    }
-    return 0;
-}
-
-int Daemon::onSnapshotTimeout(sd_event_source*, uint64_t, void* userdata) noexcept {
-    auto* pending = static_cast<PendingSnapshot*>(userdata);
-    try {
-        pending->daemon->failSnapshot(
-            pending->id, bus::kErrorNoCamera,
-            "No camera frame pair arrived within " + std::to_string(kSnapshotTimeoutUsec / 1'000'000) + " s");
     } catch (const std::exception& error) {
         ET_LOG(Error) << "internal error: " << error.what();
     }

@@ -1,15 +1,11 @@
 #pragma once
 
-#include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 #include "io/console_sink.h"
@@ -19,13 +15,16 @@
 #include "io/recording.h"
 #include "io/rig_spec.h"
 #include "io/touch_log.h"
+#include "service/bus_error.h"
 #include "service/calibration_job.h"
+#include "service/calibration_runner.h"
 #include "service/calibration_store.h"
 #include "service/config.h"
 #include "service/daemon_options.h"
 #include "service/frame_loop.h"
 #include "service/main_loop_inbox.h"
 #include "service/snapshot.h"
+#include "service/snapshot_requests.h"
 #include "service/touchscreen_output.h"
 
 namespace everytouch::service {
@@ -46,16 +45,6 @@ enum class DaemonState {
     Failed,       // the camera or the pipeline failed; the daemon is about to exit
 };
 const char* toString(DaemonState state);
-
-// What the bus-facing operations throw; the bus turns it into an error reply with this name.
-class BusError : public std::runtime_error {
-public:
-    BusError(const char* name, const std::string& message) : std::runtime_error(message), name_(name) {}
-    const char* name() const { return name_; }
-
-private:
-    const char* name_;
-};
 
 // everytouchd: the frame loop, the calibration, the configuration and the D-Bus interface around them, driven
 // by one sd-event loop on the main thread. Start-up is a straight chain of steps in run().
@@ -93,21 +82,6 @@ public:
     void snapshot(sd_bus_message* call, std::string_view what, int fd);
 
 private:
-    struct PendingSnapshot {
-        Daemon* daemon = nullptr;
-        std::uint64_t id = 0;
-        io::BusMessage call;
-        io::UniqueFd fd;
-        SnapshotKind kind = SnapshotKind::Camera;
-        FrameTap::Ticket ticket = 0;
-        io::EventSource timeout;
-    };
-
-    struct CalibrationRun {
-        std::thread thread;
-        std::atomic<bool> cancelled{false};
-    };
-
     void loadCalibration(const std::optional<io::RigDescription>& rig);
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
@@ -117,8 +91,6 @@ private:
     void onLoopNews();
     void emitContacts();
     void finishCalibration(const CalibrationOutcome& outcome);
-    void completeSnapshot(std::uint64_t id, const core::FramePair& pair);
-    void failSnapshot(std::uint64_t id, const char* errorName, const std::string& message);
     void applySettings();
     void refreshState();
     void notifyStatus();
@@ -131,7 +103,6 @@ private:
     static int onWatchdog(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
     static int onStatusTimer(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
     static int onContactsTimer(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
-    static int onSnapshotTimeout(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
 
     DaemonOptions options_;
     DaemonConfig config_;
@@ -156,9 +127,8 @@ private:
     io::EventSource contactsTimer_;
     std::unique_ptr<BusService> bus_;
     std::unique_ptr<FrameLoop> loop_;
-    std::unique_ptr<CalibrationRun> calibration_;
-    std::map<std::uint64_t, PendingSnapshot> snapshots_;
-    std::uint64_t nextSnapshotId_ = 1;
+    std::unique_ptr<CalibrationRunner> calibration_;  // while a Calibrate job runs
+    std::unique_ptr<SnapshotRequests> snapshots_;
 
     bool ready_ = false;
     DaemonState reportedState_ = DaemonState::Starting;

@@ -1,0 +1,211 @@
+#include "core/surface_height.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "core/camera_model.h"
+#include "core/geometry.h"
+
+namespace everytouch::core {
+
+namespace {
+
+constexpr double kBoxSigmaPerWidth = 0.28867513459481287;  // 1 / sqrt(12): a box one unit wide
+
+// Bilinear sample of a CV_32FC1 image; 0 outside.
+float sample(const cv::Mat& image, float x, float y) {
+    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= image.cols || y0 + 1 >= image.rows)
+        return -1.0f;
+    const float fx = x - x0, fy = y - y0;
+    const float* row0 = image.ptr<float>(y0) + x0;
+    const float* row1 = image.ptr<float>(y0 + 1) + x0;
+    return (row0[0] * (1 - fx) + row0[1] * fx) * (1 - fy) + (row1[0] * (1 - fx) + row1[1] * fx) * fy;
+}
+
+}  // namespace
+
+std::optional<std::string> HeightOptions::validate() const {
+    if (!(maxHeightMm > 0.0 && maxHeightMm <= 200.0))
+        return "maxHeightMm: must be in (0, 200] mm";
+    if (!(stepMm > 0.0 && stepMm <= maxHeightMm))
+        return "stepMm: must be positive and at most maxHeightMm";
+    if (!(skinScatterMm >= 0.0 && skinScatterMm < 10.0))
+        return "skinScatterMm: must be in [0, 10) mm";
+    if (!(regionWidths > 0.0 && regionWidths <= 3.0))
+        return "regionWidths: must be in (0, 3] finger widths";
+    if (!(significance > 0.0) || !std::isfinite(significance))
+        return "significance: must be a positive number of standard deviations";
+    return std::nullopt;
+}
+
+void HeightEvidence::clear(std::size_t heights) {
+    covariance.assign(heights, 0.0);
+    codeVariance.assign(heights, 0.0);
+    subtractionVariance = 0.0;
+    pixels = 0.0;
+}
+
+void HeightEvidence::add(const HeightEvidence& other, double weight) {
+    if (covariance.size() != other.covariance.size())
+        clear(other.covariance.size());
+    for (std::size_t i = 0; i < covariance.size(); ++i) {
+        covariance[i] += weight * other.covariance[i];
+        codeVariance[i] += weight * other.codeVariance[i];
+    }
+    subtractionVariance += weight * other.subtractionVariance;
+    pixels += weight * other.pixels;
+}
+
+SurfaceHeight::SurfaceHeight(const HeightOptions& options) : options_(options) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("height options: " + *problem);
+}
+
+void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& pattern) {
+    CV_Assert(pattern.type() == CV_8UC1 && pattern.size() == calibration.projectorSize);
+    // The scales at the display's centre: a camera pixel's footprint and a millimetre, in projector pixels.
+    const Eigen::Matrix3d tableToProjector = calibration.tableToProjectorHomography(0.0);
+    const Eigen::Vector2d centreMm = applyHomography(
+        calibration.displayToTableHomography(),
+        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const double projectorPixelsPerMm =
+        (applyHomography(tableToProjector, centreMm + Eigen::Vector2d(0.5, 0)) -
+         applyHomography(tableToProjector, centreMm - Eigen::Vector2d(0.5, 0)))
+            .norm();
+    const Eigen::Matrix3d cameraToProjector = calibration.cameraToProjectorHomography(0.0);
+    const Eigen::Vector2d centrePx = applyHomography(calibration.tableToCameraHomography(0.0), centreMm);
+    const double footprint = (applyHomography(cameraToProjector, centrePx + Eigen::Vector2d(1, 0)) -
+                              applyHomography(cameraToProjector, centrePx))
+                                 .norm();
+    const double sigma =
+        std::hypot(kBoxSigmaPerWidth * footprint, options_.skinScatterMm * projectorPixelsPerMm);
+    pattern.convertTo(panel_, CV_32FC1);
+    cv::GaussianBlur(panel_, panel_, cv::Size(), sigma);
+
+    homographies_.clear();
+    for (double d = 0.0; d <= options_.maxHeightMm + 1e-9; d += options_.stepMm)
+        homographies_.push_back(calibration.cameraToProjectorHomography(d));
+
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    undistorted_.create(calibration.cameraSize, CV_32FC2);
+    for (int y = 0; y < undistorted_.rows; ++y)
+        for (int x = 0; x < undistorted_.cols; ++x) {
+            const Eigen::Vector2d u = camera.undistortPixel(Eigen::Vector2d(x, y));
+            undistorted_.at<cv::Vec2f>(y, x) =
+                cv::Vec2f(static_cast<float>(u.x()), static_cast<float>(u.y()));
+        }
+}
+
+void SurfaceHeight::clearPixels() {
+    values_.clear();
+    points_.clear();
+}
+
+void SurfaceHeight::addPixel(const cv::Mat& subtraction, int x, int y) {
+    values_.push_back(subtraction.at<short>(y, x));
+    const cv::Vec2f& u = undistorted_.at<cv::Vec2f>(y, x);
+    points_.emplace_back(u[0], u[1]);
+}
+
+void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask,
+                                     const Eigen::Vector2d& tip, const Eigen::Vector2d& direction,
+                                     double widthPx, HeightEvidence& evidence) {
+    CV_Assert(subtraction.type() == CV_16SC1 && handMask.type() == CV_8UC1);
+    // The round end of a finger seen from above: its middle lies half a width behind the silhouette's tip.
+    const Eigen::Vector2d centre = tip - 0.5 * widthPx * direction;
+    const double radius = options_.regionWidths * widthPx;
+    const int x0 = std::max(1, static_cast<int>(std::floor(centre.x() - radius)));
+    const int x1 = std::min(subtraction.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));
+    const int y0 = std::max(1, static_cast<int>(std::floor(centre.y() - radius)));
+    const int y1 = std::min(subtraction.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
+    clearPixels();
+    for (int y = y0; y <= y1; ++y) {
+        const uchar* above = handMask.ptr<uchar>(y - 1);
+        const uchar* m = handMask.ptr<uchar>(y);
+        const uchar* below = handMask.ptr<uchar>(y + 1);
+        for (int x = x0; x <= x1; ++x) {
+            // Only pixels whose neighbours are hand too: a pixel on the outline sees some table, whose sharp
+            // code would outweigh the skin's blurred one.
+            if (!m[x] || !above[x] || !below[x] || !m[x - 1] || !m[x + 1] ||
+                (x - centre.x()) * (x - centre.x()) + (y - centre.y()) * (y - centre.y()) > radius * radius)
+                continue;
+            addPixel(subtraction, x, y);
+        }
+    }
+    measurePixels(evidence);
+}
+
+void SurfaceHeight::measurePixels(HeightEvidence& evidence) const {
+    evidence.clear(homographies_.size());
+    const std::size_t n = values_.size();
+    if (n < 8)
+        return;
+    double sum = 0.0;
+    for (float v : values_)
+        sum += v;
+    const double meanS = sum / static_cast<double>(n);
+    double varianceS = 0.0;
+    for (float v : values_)
+        varianceS += (v - meanS) * (v - meanS);
+    evidence.subtractionVariance = varianceS;
+    evidence.pixels = static_cast<double>(n);
+    for (std::size_t h = 0; h < homographies_.size(); ++h) {
+        const Eigen::Matrix3d& H = homographies_[h];
+        double sumP = 0.0, sumPP = 0.0, sumSP = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double px = H(0, 0) * points_[i].x + H(0, 1) * points_[i].y + H(0, 2);
+            const double py = H(1, 0) * points_[i].x + H(1, 1) * points_[i].y + H(1, 2);
+            const double pw = H(2, 0) * points_[i].x + H(2, 1) * points_[i].y + H(2, 2);
+            const float p =
+                std::max(0.0f, sample(panel_, static_cast<float>(px / pw), static_cast<float>(py / pw)));
+            sumP += p;
+            sumPP += p * p;
+            sumSP += (values_[i] - meanS) * p;
+        }
+        evidence.covariance[h] = sumSP;
+        evidence.codeVariance[h] = std::max(0.0, sumPP - sumP * sumP / static_cast<double>(n));
+    }
+}
+
+HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
+    HeightEstimate result;
+    const std::size_t count = evidence.covariance.size();
+    if (count == 0 || evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)
+        return result;
+    std::size_t best = 0;
+    double bestCorrelation = -2.0;
+    const auto correlationAt = [&](std::size_t h) {
+        const double denominator = std::sqrt(evidence.codeVariance[h] * evidence.subtractionVariance);
+        return denominator > 0.0 ? evidence.covariance[h] / denominator : 0.0;
+    };
+    for (std::size_t h = 0; h < count; ++h)
+        if (const double r = correlationAt(h); r > bestCorrelation) {
+            bestCorrelation = r;
+            best = h;
+        }
+    // Chance correlation over the region: neighbouring pixels share light through the blurs, about two
+    // pixels per independent sample.
+    const double chance = std::sqrt(2.0 / evidence.pixels);
+    result.correlation = bestCorrelation;
+    if (bestCorrelation < options_.significance * chance)
+        return result;
+    // The peak to a fraction of a step: the parabola through the best height and its neighbours.
+    double offset = 0.0;
+    if (best > 0 && best + 1 < count) {
+        const double a = correlationAt(best - 1), b = bestCorrelation, c = correlationAt(best + 1);
+        const double curvature = a - 2 * b + c;
+        if (curvature < 0.0)
+            offset = std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
+    }
+    result.valid = true;
+    result.heightMm = (static_cast<double>(best) + offset) * options_.stepMm;
+    // The peak's width in height over its height above chance: a sharp, strong peak pins the height down.
+    result.uncertaintyMm = options_.stepMm * chance / std::max(bestCorrelation, chance) * 4.0;
+    return result;
+}
+
+}  // namespace everytouch::core

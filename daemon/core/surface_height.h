@@ -1,0 +1,87 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include "core/calibration.h"
+
+namespace everytouch::core {
+
+// How high the surface is that the camera sees on a fingertip, from the code the projector throws on it
+// (paper section VI.C-D, beyond its single 36-bit test): the light a camera pixel sees on a surface at height
+// d came from the projector pixel that the homography of the plane at d names. For each candidate height the
+// code is predicted over the whole visible fingertip, as the camera blurs it and as skin scatters it, and
+// correlated with S there; the best height is the surface's.
+struct HeightOptions {
+    double maxHeightMm = 48.0;  // candidate heights from 0 up to this (mm)
+    double stepMm = 1.0;        // between candidate heights (mm): a fifth of a projector pixel of parallax
+    // Light spreads inside skin before it leaves it (Gaussian sigma, mm): about a millimetre for red light,
+    // which blurs the code on a finger beyond what the camera resolves.
+    double skinScatterMm = 0.8;
+    // The fingertip region: hand pixels within this many finger widths of the middle of the fingertip.
+    double regionWidths = 0.6;
+    // A correlation must exceed this many standard deviations of chance to count as seeing the code.
+    double significance = 3.0;
+
+    std::optional<std::string> validate() const;
+};
+
+// One frame's evidence about the height of a fingertip's visible surface: the covariance of S with the
+// predicted code at each candidate height, and the variances it is normalised by. Evidence of frames in which
+// the fingertip stays put is summed, which is how several frames add up to one sharper measurement.
+struct HeightEvidence {
+    std::vector<double> covariance;  // per candidate height
+    std::vector<double> codeVariance;
+    double subtractionVariance = 0.0;
+    double pixels = 0.0;
+
+    void clear(std::size_t heights);
+    void add(const HeightEvidence& other, double weight);
+};
+
+struct HeightEstimate {
+    bool valid = false;          // the code was seen on the fingertip well enough to tell a height
+    double heightMm = 0.0;       // of the visible surface above the table
+    double correlation = 0.0;    // at that height
+    double uncertaintyMm = 0.0;  // one standard deviation
+};
+
+class SurfaceHeight {
+public:
+    // Throws std::invalid_argument when options.validate() fails.
+    explicit SurfaceHeight(const HeightOptions& options);
+
+    // pattern: CV_8UC1 0/1, projector size.
+    void setRig(const Calibration& calibration, const cv::Mat& pattern);
+
+    std::size_t heights() const { return homographies_.size(); }
+    double heightOf(std::size_t candidate) const { return candidate * options_.stepMm; }
+
+    // Gathers the evidence of one frame around a fingertip (camera pixels, raw) of `widthPx` whose finger
+    // points along `direction`: subtraction S (CV_16SC1), hand mask (CV_8UC1). No allocation once sized.
+    void measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask, const Eigen::Vector2d& tip,
+                          const Eigen::Vector2d& direction, double widthPx, HeightEvidence& evidence);
+
+    // The evidence of the pixels added since clear(): for any surface, e.g. a region that might be a hand.
+    void clearPixels();
+    void addPixel(const cv::Mat& subtraction, int x, int y);
+    std::size_t pixelCount() const { return values_.size(); }
+    void measurePixels(HeightEvidence& evidence) const;
+
+    // The height the evidence supports best.
+    HeightEstimate estimate(const HeightEvidence& evidence) const;
+
+private:
+    HeightOptions options_;
+    cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
+    cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
+    std::vector<Eigen::Matrix3d> homographies_;  // undistorted camera -> projector, per candidate height
+    std::vector<float> values_;                  // S at the region's pixels
+    std::vector<cv::Point2f> points_;            // the region's undistorted pixels
+};
+
+}  // namespace everytouch::core

@@ -1,0 +1,227 @@
+#include "service/snapshot_requests.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <systemd/sd-bus.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "io/replay_source.h"
+#include "service/bus_error.h"
+#include "service/bus_names.h"
+#include "support/coded_recording.h"
+#include "support/temp_dir.h"
+
+namespace everytouch::service {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+using Clock = std::chrono::steady_clock;
+
+// How the calls were answered.
+struct Answers {
+    int done = 0;
+    std::vector<std::pair<std::string, std::string>> failures;  // error name, message
+
+    SnapshotReply reply() {
+        return {
+            [this] { ++done; },
+            [this](const char* name, const std::string& message) { failures.emplace_back(name, message); }};
+    }
+};
+
+// Draws a flat image whose first pixel is the pair's newer frame index, so the test can see which pair
+// reached the descriptor and that it went through the renderer.
+struct MarkingRenderer {
+    std::vector<SnapshotKind> kinds;
+
+    SnapshotRenderer function() {
+        return [this](SnapshotKind kind, const core::FramePair& pair, cv::Mat& image) {
+            kinds.push_back(kind);
+            image = cv::Mat(pair.latest().image.size(), CV_8UC1, cv::Scalar(77));
+            image.at<uchar>(0, 0) = static_cast<uchar>(pair.latest().index);
+        };
+    }
+};
+
+// The thing a failed add() threw.
+std::string addError(SnapshotRequests& requests, int fd, Answers& answers) {
+    try {
+        requests.add(SnapshotKind::Camera, fd, answers.reply());
+    } catch (const BusError& error) {
+        return std::string(error.name()) + ": " + error.what();
+    }
+    return "";
+}
+
+class SnapshotRequestsTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        test::writeCodedRecording(dir_ / "recording", test::smallRig(), 20, 8333);
+        sd_event* event = nullptr;
+        ASSERT_GE(sd_event_new(&event), 0);
+        event_.reset(event);
+        ASSERT_EQ(inbox_.attach(event_.get()), 0);
+        options_.overflow = FrameQueue::Overflow::Block;
+    }
+
+    // Runs the event loop, as the daemon's main thread does, until `condition` holds.
+    bool runUntil(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        while (!condition()) {
+            if (Clock::now() >= deadline)
+                return false;
+            if (sd_event_run(event_.get(), 20'000) < 0)
+                return false;
+        }
+        return true;
+    }
+
+    io::UniqueFd openForWriting(const std::string& name) {
+        return io::UniqueFd(::open((dir_ / name).c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600));
+    }
+
+    test::TempDir dir_;
+    LoopOptions options_;
+    io::Event event_;
+    MainLoopInbox inbox_;
+};
+
+TEST_F(SnapshotRequestsTest, WritesTheRenderedNextPairAndAnswersTheCall) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
+    Answers answers;
+    io::UniqueFd fd = openForWriting("snapshot.png");
+    ASSERT_TRUE(fd);
+    requests.add(SnapshotKind::Texture, fd.get(), answers.reply());
+    EXPECT_EQ(requests.pending(), 1u);
+    fd.reset();  // the request keeps its own copy: the caller may close its end at once
+
+    loop.start();
+    ASSERT_TRUE(runUntil([&] { return answers.done + answers.failures.size() > 0; }, 30s));
+    EXPECT_EQ(answers.done, 1);
+    EXPECT_TRUE(answers.failures.empty());
+    EXPECT_EQ(requests.pending(), 0u);
+    EXPECT_EQ(renderer.kinds, std::vector{SnapshotKind::Texture});
+    const cv::Mat written = cv::imread((dir_ / "snapshot.png").string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(written.empty());
+    EXPECT_EQ(written.size(), test::smallRig().calibration.cameraSize);
+    EXPECT_EQ(written.at<uchar>(0, 0), 1);  // the first pair: frames 0 and 1
+    EXPECT_EQ(written.at<uchar>(5, 5), 77);
+}
+
+TEST_F(SnapshotRequestsTest, WithoutFramesTheRequestFailsAfterItsTimeoutAndStaysAnswered) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function(),
+                              SnapshotTimeouts{50ms, 3000ms});
+    Answers answers;
+    io::UniqueFd fd = openForWriting("snapshot.png");
+    const auto begun = Clock::now();
+    requests.add(SnapshotKind::Camera, fd.get(), answers.reply());
+
+    ASSERT_TRUE(runUntil([&] { return !answers.failures.empty(); }, 10s));
+    EXPECT_GE(Clock::now() - begun, 50ms);
+    EXPECT_EQ(answers.failures.front().first, bus::kErrorNoCamera);
+    EXPECT_EQ(answers.failures.front().second, "No camera frame pair arrived within 0.05 s");
+    EXPECT_EQ(requests.pending(), 0u);
+
+    // Frames that come later find no request left: the call is not answered twice.
+    loop.start();
+    ASSERT_TRUE(runUntil([&] { return loop.finished(); }, 30s));
+    runUntil([] { return false; }, 100ms);
+    EXPECT_EQ(answers.done, 0);
+    EXPECT_EQ(answers.failures.size(), 1u);
+    EXPECT_TRUE(renderer.kinds.empty());
+    EXPECT_EQ(std::filesystem::file_size(dir_ / "snapshot.png"), 0u);
+}
+
+TEST_F(SnapshotRequestsTest, RefusesADescriptorNotOpenForWriting) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
+    Answers answers;
+    const io::UniqueFd readOnly(::open("/dev/null", O_RDONLY | O_CLOEXEC));
+    EXPECT_EQ(addError(requests, readOnly.get(), answers),
+              std::string(SD_BUS_ERROR_INVALID_ARGS) + ": The file descriptor is not open for writing");
+    EXPECT_THAT(addError(requests, -1, answers), HasSubstr(SD_BUS_ERROR_INVALID_ARGS));
+    EXPECT_EQ(requests.pending(), 0u);
+}
+
+TEST_F(SnapshotRequestsTest, RefusesOnceTheCameraHasEnded) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
+    loop.start();
+    ASSERT_TRUE(runUntil([&] { return loop.finished(); }, 30s));
+    Answers answers;
+    const io::UniqueFd fd = openForWriting("snapshot.png");
+    EXPECT_EQ(addError(requests, fd.get(), answers),
+              std::string(bus::kErrorNoCamera) + ": The camera delivers no frames");
+    EXPECT_EQ(requests.pending(), 0u);
+}
+
+TEST_F(SnapshotRequestsTest, AReaderThatWentAwayGetsAnIoError) {
+    std::signal(SIGPIPE, SIG_IGN);  // as everytouchd does
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
+    int ends[2];
+    ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
+    io::UniqueFd readEnd(ends[0]);
+    const io::UniqueFd writeEnd(ends[1]);
+    Answers answers;
+    requests.add(SnapshotKind::Camera, writeEnd.get(), answers.reply());
+    readEnd.reset();
+
+    loop.start();
+    ASSERT_TRUE(runUntil([&] { return answers.done + answers.failures.size() > 0; }, 30s));
+    EXPECT_EQ(answers.done, 0);
+    ASSERT_EQ(answers.failures.size(), 1u);
+    EXPECT_EQ(answers.failures.front().first, SD_BUS_ERROR_IO_ERROR);
+    EXPECT_THAT(answers.failures.front().second, HasSubstr("Cannot write the PNG: Broken pipe"));
+    EXPECT_EQ(requests.pending(), 0u);
+}
+
+TEST_F(SnapshotRequestsTest, FailAllAnswersEveryPendingRequest) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, {}, nullptr, options_, PipelineSettings{}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function());
+    Answers first, second;
+    const io::UniqueFd fd = openForWriting("snapshot.png");
+    requests.add(SnapshotKind::Camera, fd.get(), first.reply());
+    requests.add(SnapshotKind::Overlay, fd.get(), second.reply());
+    EXPECT_EQ(requests.pending(), 2u);
+
+    requests.failAll(bus::kErrorNoCamera, "everytouchd is stopping");
+    EXPECT_EQ(requests.pending(), 0u);
+    for (const Answers* answers : {&first, &second}) {
+        EXPECT_EQ(answers->done, 0);
+        ASSERT_EQ(answers->failures.size(), 1u);
+        EXPECT_EQ(answers->failures.front().first, bus::kErrorNoCamera);
+        EXPECT_EQ(answers->failures.front().second, "everytouchd is stopping");
+    }
+}
+
+}  // namespace
+}  // namespace everytouch::service
