@@ -4,15 +4,15 @@
 
 namespace everytouch::core {
 
-std::optional<std::string> grayFrame(const cv::Mat& cameraImage, cv::Mat& gray) {
+Status grayFrame(const cv::Mat& cameraImage, cv::Mat& gray) {
     if (cameraImage.empty() || cameraImage.depth() != CV_8U ||
         (cameraImage.channels() != 1 && cameraImage.channels() != 3))
-        return "camera frame: expected an 8-bit gray or BGR image";
+        return Failure{"camera frame: expected an 8-bit gray or BGR image"};
     if (cameraImage.channels() == 3)
         cv::cvtColor(cameraImage, gray, cv::COLOR_BGR2GRAY);
     else
         gray = cameraImage;
-    return std::nullopt;
+    return {};
 }
 
 }  // namespace everytouch::core

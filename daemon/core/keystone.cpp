@@ -19,16 +19,11 @@ double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 
 }  // namespace
 
-KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySize) {
-    KeystoneFit fit;
-    if (displaySize.width <= 0 || displaySize.height <= 0) {
-        fit.message = "display_size: width and height must be positive";
-        return fit;
-    }
-    if (calibration.projectorSize.width <= 0 || calibration.projectorSize.height <= 0) {
-        fit.message = "projector_size: width and height must be positive";
-        return fit;
-    }
+Result<KeystoneFit> fitDisplayToTable(const Calibration& calibration, cv::Size displaySize) {
+    if (displaySize.width <= 0 || displaySize.height <= 0)
+        return Failure{"display_size: width and height must be positive"};
+    if (calibration.projectorSize.width <= 0 || calibration.projectorSize.height <= 0)
+        return Failure{"projector_size: width and height must be positive"};
 
     // The lit quadrilateral: the panel's outer pixel edges on the table.
     const Eigen::Matrix3d tableToProjector = calibration.tableToProjectorHomography();
@@ -45,18 +40,14 @@ KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySi
         scale[index] = onTable.z();
         quad[index] = onTable.hnormalized();
     }
-    if (!(scale[0] * scale[1] > 0 && scale[0] * scale[2] > 0 && scale[0] * scale[3] > 0)) {
-        fit.message = "table_to_projector: part of the projector's image never reaches the table";
-        return fit;
-    }
+    if (!(scale[0] * scale[1] > 0 && scale[0] * scale[2] > 0 && scale[0] * scale[3] > 0))
+        return Failure{"table_to_projector: part of the projector's image never reaches the table"};
     double orientation = 0;
     for (int index = 0; index < 4; ++index) {
         const double turn =
             cross(quad[(index + 1) % 4] - quad[index], quad[(index + 2) % 4] - quad[(index + 1) % 4]);
-        if (index > 0 && !(turn * orientation > 0)) {
-            fit.message = "table_to_projector: the lit area on the table is not a convex quadrilateral";
-            return fit;
-        }
+        if (index > 0 && !(turn * orientation > 0))
+            return Failure{"table_to_projector: the lit area on the table is not a convex quadrilateral"};
         orientation = turn;
     }
 
@@ -116,10 +107,8 @@ KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySi
         if (vertex.z() >= bestWidth * (1.0 - 1e-12))
             optima.push_back(vertex);
     }
-    if (optima.empty()) {
-        fit.message = "table_to_projector: no rectangle fits inside the lit area";
-        return fit;
-    }
+    if (optima.empty())
+        return Failure{"table_to_projector: no rectangle fits inside the lit area"};
     // Several optimal vertices: the optimum is an edge of the feasible set; its middle centres the display.
     Eigen::Vector3d optimum = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& vertex : optima)
@@ -129,6 +118,7 @@ KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySi
     const Eigen::Vector2d rectangleCentre = optimum.head<2>();
     const double millimetresPerPixel = optimum.z() / displaySize.width;
     const Eigen::Vector2d halfExtent = halfExtentPerWidth * optimum.z();
+    KeystoneFit fit;
     fit.tableRectangleMm = Eigen::AlignedBox2d(rectangleCentre - halfExtent, rectangleCentre + halfExtent);
 
     // Display pixel centres sit at integers: the display's outer edges are at -0.5 and size - 0.5.
@@ -140,7 +130,6 @@ KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySi
         rectangleCentre - millimetresPerPixel * (displayX * displayCentre.x() + displayY * displayCentre.y());
     fit.displayToProjector = tableToProjector * displayToTable;
     fit.displayToProjector /= fit.displayToProjector(2, 2);
-    fit.success = true;
     return fit;
 }
 

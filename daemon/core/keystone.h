@@ -1,18 +1,15 @@
 #pragma once
 
-#include <string>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <opencv2/core/types.hpp>
 
 #include "core/calibration.h"
+#include "core/result.h"
 
 namespace everytouch::core {
 
 struct KeystoneFit {
-    bool success = false;
-    std::string message;                                               // why not, when not
     Eigen::Matrix3d displayToProjector = Eigen::Matrix3d::Identity();  // H_dp
     Eigen::AlignedBox2d tableRectangleMm;  // where the display appears on the table, table axes
 };
@@ -21,7 +18,8 @@ struct KeystoneFit {
 // aspect ratio, with sides along the table's x and y axes, that fits inside the quadrilateral the projector
 // lights on the table, so that it appears undistorted: right angles, square pixels. The display keeps the
 // projector's orientation (its x axis is the table axis closest to the projector's x axis; never mirrored).
-// Uses the projector's size, matrix and table pose from `calibration`.
-KeystoneFit fitDisplayToTable(const Calibration& calibration, cv::Size displaySize);
+// Uses the projector's size, matrix and table pose from `calibration`. Fails when the lit area is not a
+// convex quadrilateral on the table or either size is empty.
+Result<KeystoneFit> fitDisplayToTable(const Calibration& calibration, cv::Size displaySize);
 
 }  // namespace everytouch::core

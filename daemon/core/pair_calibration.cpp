@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -249,16 +250,10 @@ Eigen::Isometry3d toIsometry(const cv::Mat& rotationVector, const cv::Mat& trans
     return pose;
 }
 
-struct InitialEstimate {
-    Eigen::VectorXd parameters;
-    std::string failure;
-};
-
-InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairCalibrationOptions& options,
-                                int parameterCount, const PairResiduals& residuals) {
-    InitialEstimate estimate;
-    estimate.parameters = Eigen::VectorXd::Zero(parameterCount);
-
+// The closed-form start of the minimisation: every parameter of the layout `residuals` uses.
+Result<Eigen::VectorXd> initialEstimate(const std::vector<PlaneView>& views,
+                                        const PairCalibrationOptions& options, int parameterCount,
+                                        const PairResiduals& residuals) {
     // Camera: principal point at the centre, focal length from the rectangles, no distortion.
     const Eigen::Vector2d centre((options.cameraSize.width - 1) / 2.0, (options.cameraSize.height - 1) / 2.0);
     const std::vector<Eigen::Vector2d> model = rectangleModel(options.rectangleSizeMm);
@@ -310,8 +305,7 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
             translations,
             cv::CALIB_ZERO_TANGENT_DIST | cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3);
     } catch (const cv::Exception& error) {
-        estimate.failure = std::string("initial projector estimate failed: ") + error.what();
-        return estimate;
+        return Failure{std::string("initial projector estimate failed: ") + error.what()};
     }
     for (int row = 0; row < 3; ++row)
         for (int column = 0; column < 3; ++column)
@@ -333,7 +327,7 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
     pair.cameraToProjector.linear() = Eigen::Quaterniond(quaternionSum.normalized()).toRotationMatrix();
     pair.cameraToProjector.translation() = translationSum / static_cast<double>(rectanglePoses.size());
 
-    Eigen::VectorXd& parameters = estimate.parameters;
+    Eigen::VectorXd parameters = Eigen::VectorXd::Zero(parameterCount);
     parameters.head<4>() << focal, focal, centre.x(), centre.y();
     parameters.segment<4>(6) << pair.projectorMatrix(0, 0), pair.projectorMatrix(1, 1),
         pair.projectorMatrix(0, 2), pair.projectorMatrix(1, 2);
@@ -348,14 +342,12 @@ InitialEstimate initialEstimate(const std::vector<PlaneView>& views, const PairC
             continue;
         }
         const std::optional<Eigen::Hyperplane<double, 3>> plane = triangulatePlane(pair, views[view]);
-        if (!plane) {
-            estimate.failure = "view " + std::to_string(view + 1) +
-                               ": its correspondences do not triangulate to a plane in front of the camera";
-            return estimate;
-        }
+        if (!plane)
+            return Failure{"view " + std::to_string(view + 1) +
+                           ": its correspondences do not triangulate to a plane in front of the camera"};
         parameters.segment<3>(offset) = inverseDepthOf(*plane);
     }
-    return estimate;
+    return parameters;
 }
 
 // Every n-th correspondence, so that at most `limit` remain.
@@ -416,31 +408,25 @@ std::optional<std::string> PairCalibrationOptions::validate() const {
     return std::nullopt;
 }
 
-PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views,
-                                             const PairCalibrationOptions& options) {
+Result<PairCalibration> calibrateProjectorCameraPair(const std::vector<PlaneView>& views,
+                                                     const PairCalibrationOptions& options) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("PairCalibrationOptions: " + *problem);
     PairCalibration calibration;
-    if (auto problem = options.validate()) {
-        calibration.message = *problem;
-        return calibration;
-    }
     std::vector<PlaneView> used;
     int rectangleViews = 0;
     for (size_t view = 0; view < views.size(); ++view) {
         if (views[view].cameraPoints.size() != views[view].projectorPoints.size() ||
-            views[view].cameraPoints.size() < 8) {
-            calibration.message = "view " + std::to_string(view + 1) +
-                                  ": need at least 8 camera <-> projector correspondences, as many of each";
-            return calibration;
-        }
+            views[view].cameraPoints.size() < 8)
+            return Failure{"view " + std::to_string(view + 1) +
+                           ": need at least 8 camera <-> projector correspondences, as many of each"};
         used.push_back(thinned(views[view], options.maxPointsPerView));
         rectangleViews += views[view].rectangleCorners ? 1 : 0;
     }
     constexpr int kMinRectangleViews = 3;
-    if (rectangleViews < kMinRectangleViews) {
-        calibration.message = "the rectangle lies on " + std::to_string(rectangleViews) +
-                              " of the views; it must lie on at least 3 differently tilted surfaces";
-        return calibration;
-    }
+    if (rectangleViews < kMinRectangleViews)
+        return Failure{"the rectangle lies on " + std::to_string(rectangleViews) +
+                       " of the views; it must lie on at least 3 differently tilted surfaces"};
 
     int parameterCount = kPairParameters, residualTotal = 0;
     for (const PlaneView& view : used) {
@@ -449,13 +435,11 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
     }
     const ParameterLayout layout(options.squarePixels, parameterCount);
     PairResiduals residuals(used, options, layout, residualTotal);
-    InitialEstimate initial = initialEstimate(used, options, parameterCount, residuals);
-    if (!initial.failure.empty()) {
-        calibration.message = initial.failure;
-        return calibration;
-    }
+    const Result<Eigen::VectorXd> initial = initialEstimate(used, options, parameterCount, residuals);
+    if (!initial.ok())
+        return initial.failure();
 
-    Eigen::VectorXd free = layout.reduce(initial.parameters);
+    Eigen::VectorXd free = layout.reduce(initial.value());
     Eigen::LevenbergMarquardt<PairResiduals> solver(residuals);
     solver.setMaxfev(1000);
     solver.setXtol(1e-12);
@@ -478,10 +462,8 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
     residuals.df(free, jacobian);
     calibration.standardDeviation = uncertaintyOf(jacobian, finalResiduals, layout);
 
-    if (status == Eigen::LevenbergMarquardtSpace::ImproperInputParameters || !finalResiduals.allFinite()) {
-        calibration.message = "the least squares did not run: the initial estimate is not usable";
-        return calibration;
-    }
+    if (status == Eigen::LevenbergMarquardtSpace::ImproperInputParameters || !finalResiduals.allFinite())
+        return Failure{"the least squares did not run: the initial estimate is not usable"};
     // Rectangles on parallel surfaces carry the same metric information over and over.
     double widestTiltDeg = 0.0;
     for (size_t first = 0; first < used.size(); ++first)
@@ -500,8 +482,7 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
             "the surfaces carrying the rectangle differ in tilt by %.1f degrees at most; tilt the board "
             "by %.0f degrees or more in different directions",
             widestTiltDeg, kMinTiltDeg);
-        calibration.message = message;
-        return calibration;
+        return Failure{message};
     }
     if (!(calibration.rmsPx.all <= options.maxRmsPx)) {
         char message[200];
@@ -510,10 +491,8 @@ PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views
             "RMS reprojection error %.2f px exceeds %.2f px (camera %.2f, projector %.2f): views of "
             "surfaces that are not flat, or correspondences that are wrong",
             calibration.rmsPx.all, options.maxRmsPx, calibration.rmsPx.camera, calibration.rmsPx.projector);
-        calibration.message = message;
-        return calibration;
+        return Failure{message};
     }
-    calibration.success = true;
     return calibration;
 }
 

@@ -10,6 +10,7 @@
 
 #include "core/plane_view.h"
 #include "core/projector_camera_pair.h"
+#include "core/result.h"
 
 namespace everytouch::core {
 
@@ -39,8 +40,6 @@ struct PairUncertainty {
 };
 
 struct PairCalibration {
-    bool success = false;
-    std::string message;  // why not, when not
     ProjectorCameraPair pair;
     std::vector<Eigen::Hyperplane<double, 3>> planes;  // each view's surface, camera frame, mm
     ReprojectionRms rmsPx;
@@ -57,8 +56,10 @@ struct PairCalibration {
 // three differently tilted surfaces (docs/calibration.md has the figures). Starts from a closed-form estimate
 // (principal point at the centre, focal length from the rectangles' homographies, the projector calibrated
 // from the surfaces so found) and minimises the reprojection errors in both devices over all parameters and
-// the surfaces' poses with Levenberg-Marquardt.
-PairCalibration calibrateProjectorCameraPair(const std::vector<PlaneView>& views,
-                                             const PairCalibrationOptions& options);
+// the surfaces' poses with Levenberg-Marquardt. Fails, naming the view, when the views cannot determine the
+// pair, and when the RMS reprojection error exceeds options.maxRmsPx. Throws std::invalid_argument when
+// options.validate() fails.
+Result<PairCalibration> calibrateProjectorCameraPair(const std::vector<PlaneView>& views,
+                                                     const PairCalibrationOptions& options);
 
 }  // namespace everytouch::core

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -198,6 +199,8 @@ std::optional<std::string> ChessboardOptions::validate(cv::Size projectorSize) c
 }
 
 void renderProjectorChessboard(const ChessboardOptions& options, cv::Size projectorSize, cv::Mat& image) {
+    if (auto problem = options.validate(projectorSize))
+        throw std::invalid_argument("ChessboardOptions: " + *problem);
     image.create(projectorSize, CV_8UC1);
     image.setTo(cv::Scalar(255));
     const cv::Size squares = squareCount(options);
@@ -223,28 +226,21 @@ std::vector<Eigen::Vector2d> projectorChessboardCorners(const ChessboardOptions&
     return corners;
 }
 
-ChessboardDetection detectProjectedChessboard(const cv::Mat& cameraImage, const ChessboardOptions& options,
-                                              cv::Size projectorSize) {
-    ChessboardDetection detection;
-    if (auto problem = options.validate(projectorSize)) {
-        detection.message = *problem;
-        return detection;
-    }
+Result<ChessboardDetection> detectProjectedChessboard(const cv::Mat& cameraImage,
+                                                      const ChessboardOptions& options,
+                                                      cv::Size projectorSize) {
+    if (auto problem = options.validate(projectorSize))
+        throw std::invalid_argument("ChessboardOptions: " + *problem);
     cv::Mat gray;
-    if (auto problem = grayFrame(cameraImage, gray)) {
-        detection.message = *problem;
-        return detection;
-    }
+    if (const Status frame = grayFrame(cameraImage, gray); !frame.ok())
+        return frame.failure();
 
     std::vector<cv::Point2f> corners;
     // Without the fast check the finder spends seconds on a frame that has no board.
     const int flags = cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK;
-    if (!cv::findChessboardCorners(gray, options.innerCorners, corners, flags)) {
-        detection.message = "no projected chessboard of " + std::to_string(options.innerCorners.width) +
-                            " x " + std::to_string(options.innerCorners.height) +
-                            " inner corners in the camera frame";
-        return detection;
-    }
+    if (!cv::findChessboardCorners(gray, options.innerCorners, corners, flags))
+        return Failure{"no projected chessboard of " + std::to_string(options.innerCorners.width) + " x " +
+                       std::to_string(options.innerCorners.height) + " inner corners in the camera frame"};
 
     // The refinement window must stay inside the four squares around a corner.
     double spacing = std::numeric_limits<double>::infinity();
@@ -274,30 +270,28 @@ ChessboardDetection detectProjectedChessboard(const cv::Mat& cameraImage, const 
             best = reading;
         }
     }
-    if (!best) {
-        detection.message = "projected chessboard: cannot tell its black squares from its white ones";
-        return detection;
-    }
+    if (!best)
+        return Failure{"projected chessboard: cannot tell its black squares from its white ones"};
 
+    ChessboardDetection detection;
     detection.cameraCorners.reserve(corners.size());
     detection.projectorCorners.reserve(corners.size());
     for (size_t index = 0; index < corners.size(); ++index) {
         detection.cameraCorners.emplace_back(corners[index].x, corners[index].y);
         detection.projectorCorners.push_back(boardCorners[boardIndex(*best, static_cast<int>(index), inner)]);
     }
-    detection.success = true;
     return detection;
 }
 
-ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage,
-                                                    const ChessboardOptions& options, cv::Size projectorSize,
-                                                    const CameraModel& camera) {
+Result<ProjectorToCameraEstimate> estimateProjectorToCamera(const cv::Mat& cameraImage,
+                                                            const ChessboardOptions& options,
+                                                            cv::Size projectorSize,
+                                                            const CameraModel& camera) {
+    Result<ChessboardDetection> detection = detectProjectedChessboard(cameraImage, options, projectorSize);
+    if (!detection.ok())
+        return detection.failure();
     ProjectorToCameraEstimate estimate;
-    estimate.detection = detectProjectedChessboard(cameraImage, options, projectorSize);
-    if (!estimate.detection.success) {
-        estimate.message = estimate.detection.message;
-        return estimate;
-    }
+    estimate.detection = std::move(detection).value();
     std::vector<Eigen::Vector2d> undistorted;
     undistorted.reserve(estimate.detection.cameraCorners.size());
     for (const Eigen::Vector2d& corner : estimate.detection.cameraCorners)
@@ -309,11 +303,9 @@ ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage,
         cv::findHomography(projector, cameraPoints, cv::RANSAC, options.maxCornerErrorPx, inlierMask);
     const int total = static_cast<int>(projector.size());
     estimate.inliers = static_cast<int>(std::count(inlierMask.begin(), inlierMask.end(), 1));
-    if (fitted.empty() || 2 * estimate.inliers < total) {
-        estimate.message = "projected chessboard: only " + std::to_string(estimate.inliers) + " of " +
-                           std::to_string(total) + " corners agree on one plane";
-        return estimate;
-    }
+    if (fitted.empty() || 2 * estimate.inliers < total)
+        return Failure{"projected chessboard: only " + std::to_string(estimate.inliers) + " of " +
+                       std::to_string(total) + " corners agree on one plane"};
     estimate.homography = toEigen(fitted);
     double sumSquares = 0.0;
     for (int index = 0; index < total; ++index) {
@@ -324,7 +316,6 @@ ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage,
         sumSquares += (predicted - undistorted[index]).squaredNorm();
     }
     estimate.rmsPx = std::sqrt(sumSquares / estimate.inliers);
-    estimate.success = true;
     return estimate;
 }
 

@@ -8,6 +8,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "core/camera_model.h"
+#include "core/result.h"
 
 namespace everytouch::core {
 
@@ -31,6 +32,7 @@ struct ChessboardOptions {
 };
 
 // The projector image: the board on white, 8-bit gray, projectorSize. Reallocated only on a size change.
+// Throws std::invalid_argument when options.validate(projectorSize) fails.
 void renderProjectorChessboard(const ChessboardOptions& options, cv::Size projectorSize, cv::Mat& image);
 
 // The board's inner corners in projector pixels (pixel centres at integers), row by row from the top left.
@@ -39,20 +41,18 @@ std::vector<Eigen::Vector2d> projectorChessboardCorners(const ChessboardOptions&
 
 // Camera <-> projector correspondences from a camera frame of the projected board.
 struct ChessboardDetection {
-    bool success = false;
-    std::string message;                            // why not, when not
     std::vector<Eigen::Vector2d> cameraCorners;     // raw camera pixels, sub-pixel
     std::vector<Eigen::Vector2d> projectorCorners;  // the same corners on the projector panel
 };
 
 // Finds the board in an 8-bit gray or BGR camera frame. A frame without a board fails within milliseconds.
-ChessboardDetection detectProjectedChessboard(const cv::Mat& cameraImage, const ChessboardOptions& options,
-                                              cv::Size projectorSize);
+// Throws std::invalid_argument when options.validate(projectorSize) fails.
+Result<ChessboardDetection> detectProjectedChessboard(const cv::Mat& cameraImage,
+                                                      const ChessboardOptions& options,
+                                                      cv::Size projectorSize);
 
 // H_CP: projector pixels -> undistorted camera pixels, for a board on one plane.
 struct ProjectorToCameraEstimate {
-    bool success = false;
-    std::string message;
     Eigen::Matrix3d homography = Eigen::Matrix3d::Identity();
     double rmsPx = 0.0;  // corner reprojection error of the inliers, camera pixels
     int inliers = 0;
@@ -60,9 +60,11 @@ struct ProjectorToCameraEstimate {
 };
 
 // Detects the board and fits H_CP robustly (RANSAC, then least squares on the inliers) to the corners
-// undistorted with `camera`.
-ProjectorToCameraEstimate estimateProjectorToCamera(const cv::Mat& cameraImage,
-                                                    const ChessboardOptions& options, cv::Size projectorSize,
-                                                    const CameraModel& camera);
+// undistorted with `camera`. Fails when the board is not found or fewer than half of its corners agree on one
+// plane.
+Result<ProjectorToCameraEstimate> estimateProjectorToCamera(const cv::Mat& cameraImage,
+                                                            const ChessboardOptions& options,
+                                                            cv::Size projectorSize,
+                                                            const CameraModel& camera);
 
 }  // namespace everytouch::core

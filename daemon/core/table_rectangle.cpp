@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -228,18 +229,15 @@ std::optional<std::string> TableRectangleOptions::validate() const {
     return std::nullopt;
 }
 
-TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const TableRectangleOptions& options,
-                                           const CameraModel& camera) {
-    TableRectangleDetection detection;
-    if (auto problem = options.validate()) {
-        detection.message = *problem;
-        return detection;
-    }
+Result<TableRectangleDetection> findTableRectangle(const cv::Mat& cameraImage,
+                                                   const TableRectangleOptions& options,
+                                                   const CameraModel& camera) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("TableRectangleOptions: " + *problem);
     cv::Mat gray;
-    if (auto problem = grayFrame(cameraImage, gray)) {
-        detection.message = *problem;
-        return detection;
-    }
+    if (const Status frame = grayFrame(cameraImage, gray); !frame.ok())
+        return frame.failure();
+    TableRectangleDetection detection;
 
     // Dark against the local surroundings. The window spans a quarter of the frame, several times a stripe's
     // width; a larger dark rectangle shows up as a ring whose outline is still the rectangle.
@@ -312,8 +310,7 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         char message[128];
         std::snprintf(message, sizeof message, "no dark rectangle of %.1f x %.1f mm in the camera frame",
                       options.sizeMm.width, options.sizeMm.height);
-        detection.message = message;
-        return detection;
+        return Failure{message};
     }
     const Candidate& best =
         *std::min_element(candidates.begin(), candidates.end(),
@@ -325,7 +322,6 @@ TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const Tab
         fitHomography({{0, 0}, {w, 0}, {w, h}, {0, h}}, {detection.corners.begin(), detection.corners.end()});
     detection.edgeRmsPx = best.edgeRmsPx;
     detection.contrastDn = best.contrastDn;
-    detection.success = true;
     return detection;
 }
 

@@ -8,6 +8,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "core/camera_model.h"
+#include "core/result.h"
 
 namespace everytouch::core {
 
@@ -30,8 +31,6 @@ struct TableRectangleOptions {
 };
 
 struct TableRectangleDetection {
-    bool success = false;
-    std::string message;  // why not, when not
     // The corners at table (0, 0), (w, 0), (w, h), (0, h) mm, in undistorted pixels of the camera model. The
     // table's x axis runs along the longer side towards increasing camera columns; y completes a right-handed
     // frame with z towards the camera.
@@ -45,8 +44,10 @@ struct TableRectangleDetection {
 
 // Finds the rectangle in an 8-bit gray or BGR camera frame. Its edges are located to sub-pixel precision
 // (level crossings across each edge, undistorted with `camera`, one line fitted per edge) and the corners are
-// the lines' intersections. A default CameraModel reports raw pixels.
-TableRectangleDetection findTableRectangle(const cv::Mat& cameraImage, const TableRectangleOptions& options,
-                                           const CameraModel& camera = {});
+// the lines' intersections. A default CameraModel reports raw pixels. Fails when no such rectangle is in
+// view; throws std::invalid_argument when options.validate() fails.
+Result<TableRectangleDetection> findTableRectangle(const cv::Mat& cameraImage,
+                                                   const TableRectangleOptions& options,
+                                                   const CameraModel& camera = {});
 
 }  // namespace everytouch::core

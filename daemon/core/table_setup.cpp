@@ -1,6 +1,8 @@
 #include "core/table_setup.h"
 
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 #include <Eigen/SVD>
 #include <unsupported/Eigen/LevenbergMarquardt>
@@ -50,34 +52,23 @@ std::optional<std::string> TableSetupOptions::validate() const {
     return std::nullopt;
 }
 
-TableSetup setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
-                      const TableSetupOptions& options) {
-    TableSetup setup;
-    if (auto problem = options.validate()) {
-        setup.message = *problem;
-        return setup;
-    }
-    if (!table.rectangleCorners) {
-        setup.message = "table view: the rectangle was not found on the table";
-        return setup;
-    }
-    if (table.cameraPoints.size() != table.projectorPoints.size() || table.cameraPoints.size() < 3) {
-        setup.message =
-            "table view: need at least three camera <-> projector correspondences, as many of each";
-        return setup;
-    }
+Result<TableSetup> setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
+                              const TableSetupOptions& options) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("TableSetupOptions: " + *problem);
+    if (!table.rectangleCorners)
+        return Failure{"table view: the rectangle was not found on the table"};
+    if (table.cameraPoints.size() != table.projectorPoints.size() || table.cameraPoints.size() < 3)
+        return Failure{
+            "table view: need at least three camera <-> projector correspondences, as many of each"};
 
     const std::optional<Eigen::Hyperplane<double, 3>> plane = triangulatePlane(pair, table);
-    if (!plane) {
-        setup.message = "table view: the correspondences do not span a plane in front of the camera";
-        return setup;
-    }
+    if (!plane)
+        return Failure{"table view: the correspondences do not span a plane in front of the camera"};
     const std::optional<Eigen::Isometry3d> initial =
         rectangleOnPlane(pair.camera, *plane, *table.rectangleCorners, options.rectangleSizeMm);
-    if (!initial) {
-        setup.message = "table view: the rectangle's corners are not in table order on the plane";
-        return setup;
-    }
+    if (!initial)
+        return Failure{"table view: the rectangle's corners are not in table order on the plane"};
 
     Eigen::VectorXd parameters(6);
     parameters << vectorFromRotation(initial->rotation()), initial->translation();
@@ -85,6 +76,7 @@ TableSetup setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
         TablePoseResiduals(pair, table, options.rectangleSizeMm));
     Eigen::LevenbergMarquardt<Eigen::NumericalDiff<TablePoseResiduals>> solver(residuals);
     solver.minimize(parameters);
+    TableSetup setup;
     setup.iterations = static_cast<int>(solver.iterations());
 
     const Eigen::Isometry3d tableToCamera = tablePose(parameters);
@@ -98,10 +90,8 @@ TableSetup setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
             message, sizeof message,
             "table set-up: RMS reprojection error %.2f px exceeds %.2f px (camera %.2f, projector %.2f)",
             setup.rmsPx.all, options.maxRmsPx, setup.rmsPx.camera, setup.rmsPx.projector);
-        setup.message = message;
-        return setup;
+        return Failure{message};
     }
-    setup.success = true;
     return setup;
 }
 

@@ -8,6 +8,7 @@
 #include "core/calibration.h"
 #include "core/plane_view.h"
 #include "core/projector_camera_pair.h"
+#include "core/result.h"
 
 namespace everytouch::core {
 
@@ -22,8 +23,6 @@ struct TableSetupOptions {
 };
 
 struct TableSetup {
-    bool success = false;
-    std::string message;  // why not, when not
     // The pair with the table found: table_to_camera and table_to_projector set, display fields at defaults.
     Calibration calibration;
     ReprojectionRms rmsPx;
@@ -33,9 +32,10 @@ struct TableSetup {
 // The paper's quick set-up on top of the pair's one-time calibration: camera <-> projector correspondences of
 // one pattern projected on the table give the table's plane; the rectangle lying on it gives the table frame:
 // origin at the rectangle's (0, 0) corner, x along its longer side, z up towards the camera. The table pose
-// is refined by minimising the reprojection errors in both devices. `table` must have rectangle corners and
-// at least three correspondences.
-TableSetup setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
-                      const TableSetupOptions& options);
+// is refined by minimising the reprojection errors in both devices. Fails, naming what is wrong, when `table`
+// lacks the rectangle's corners or three correspondences, when they do not give a table, and when the RMS
+// reprojection error exceeds options.maxRmsPx; throws std::invalid_argument when options.validate() fails.
+Result<TableSetup> setUpTable(const ProjectorCameraPair& pair, const PlaneView& table,
+                              const TableSetupOptions& options);
 
 }  // namespace everytouch::core

@@ -78,12 +78,12 @@ CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
                                   },
                                   i > 0};
         EstimateResult result = step.run(context);
-        if (!result.calibration) {
-            outcome.message = "the " + step.name + " step failed: " + result.problem;
+        if (!result.ok()) {
+            outcome.message = "the " + step.name + " step failed: " + result.failure().message;
             return outcome;
         }
-        current = std::move(result.calibration);
-        outcome.rmsPx = std::max(outcome.rmsPx, result.rmsPx);
+        outcome.rmsPx = std::max(outcome.rmsPx, result->rmsPx);
+        current = std::move(result->calibration);
         progress(step.name, begun + stepShare, "Done with " + step.description);
     }
     outcome.ok = true;

@@ -5,13 +5,13 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
 
 #include "core/calibration.h"
 #include "core/frame.h"
+#include "core/result.h"
 
 namespace everytouch::service {
 
@@ -28,15 +28,13 @@ struct CalibrationOptions {
     std::optional<std::string> validate() const;
 };
 
-// What a step makes of what it captured: a new calibration and its RMS reprojection error, or the
-// reason it could not find one.
-struct EstimateResult {
-    std::optional<core::Calibration> calibration;
+// What a step makes of what it captured: a new calibration and its RMS reprojection error.
+struct Estimate {
+    core::Calibration calibration;
     double rmsPx = 0.0;
-    std::string problem;
-
-    static EstimateResult failed(std::string problem) { return {std::nullopt, 0.0, std::move(problem)}; }
 };
+// The estimate, or the reason the step could not find one.
+using EstimateResult = core::Result<Estimate>;
 
 // Captures the next `pairs` frame pairs; nothing when none came (camera gone, job cancelled).
 using CaptureFunction = std::function<std::optional<std::vector<core::FramePair>>(std::size_t pairs)>;

@@ -137,8 +137,8 @@ PoseCapture::PoseCapture(const PoseCaptureOptions& options, const core::Chessboa
 
 PoseCapture::Event PoseCapture::offer(const core::FramePair& pair) {
     core::computeSubtractionAndTexture(pair, subtraction_, texture_);
-    if (const std::optional<std::string> problem = core::grayFrame(texture_, gray_)) {
-        problem_ = "the camera frames: " + *problem;
+    if (const core::Status frame = core::grayFrame(texture_, gray_); !frame.ok()) {
+        problem_ = "the camera frames: " + frame.failure().message;
         return Event::Refused;
     }
     switch (stillness_.offer(gray_, pair.latest().timestampUs)) {
@@ -154,50 +154,46 @@ PoseCapture::Event PoseCapture::offer(const core::FramePair& pair) {
         return Event::Waiting;
     looked_ = true;
     stillness_.average(average_);
-    PoseAttempt attempt = this->attempt(average_);
-    if (!attempt.accepted) {
-        problem_ = attempt.problem;
+    core::Result<Pose> pose = attempt(average_);
+    if (!pose.ok()) {
+        problem_ = pose.failure().message;
         return Event::Refused;
     }
     problem_.clear();
-    views_.push_back(std::move(attempt.view));
-    normals_.push_back(attempt.normal);
+    views_.push_back(std::move(pose->view));
+    normals_.push_back(pose->normal);
     return Event::Captured;
 }
 
-PoseAttempt PoseCapture::attempt(const cv::Mat& texture) const {
-    PoseAttempt attempt;
-    const core::ChessboardDetection board = core::detectProjectedChessboard(texture, board_, projectorSize_);
-    if (!board.success) {
-        attempt.problem = "the projected chessboard is not in view whole (" + board.message + ")";
-        return attempt;
-    }
+core::Result<Pose> PoseCapture::attempt(const cv::Mat& texture) const {
+    const core::Result<core::ChessboardDetection> board =
+        core::detectProjectedChessboard(texture, board_, projectorSize_);
+    if (!board.ok())
+        return core::Failure{"the projected chessboard is not in view whole (" + board.failure().message +
+                             ")"};
     core::TableRectangleOptions cardOptions;
     cardOptions.sizeMm = cardSizeMm_;
-    const core::TableRectangleDetection card = core::findTableRectangle(texture, cardOptions, camera_);
-    if (!card.success) {
-        attempt.problem = "the card's stripe is not in view (" + card.message + ")";
-        return attempt;
-    }
-    attempt.normal = rectangleSurfaceNormal(card.corners, cardSizeMm_, camera_.matrix);
+    const core::Result<core::TableRectangleDetection> card =
+        core::findTableRectangle(texture, cardOptions, camera_);
+    if (!card.ok())
+        return core::Failure{"the card's stripe is not in view (" + card.failure().message + ")"};
+    Pose pose;
+    pose.normal = rectangleSurfaceNormal(card->corners, cardSizeMm_, camera_.matrix);
     for (std::size_t view = 0; view < normals_.size(); ++view) {
         const double tiltDeg =
-            std::acos(std::clamp(attempt.normal.dot(normals_[view]), -1.0, 1.0)) * 180.0 / M_PI;
-        if (tiltDeg < options_.minTiltDeg) {
-            attempt.problem = "the surface is tilted only " + formatDegrees(tiltDeg) +
-                              " degrees against pose " + std::to_string(view + 1) + "; it needs " +
-                              formatDegrees(options_.minTiltDeg) + " or more";
-            return attempt;
-        }
+            std::acos(std::clamp(pose.normal.dot(normals_[view]), -1.0, 1.0)) * 180.0 / M_PI;
+        if (tiltDeg < options_.minTiltDeg)
+            return core::Failure{"the surface is tilted only " + formatDegrees(tiltDeg) +
+                                 " degrees against pose " + std::to_string(view + 1) + "; it needs " +
+                                 formatDegrees(options_.minTiltDeg) + " or more"};
     }
-    attempt.view.cameraPoints = board.cameraCorners;
-    attempt.view.projectorPoints = board.projectorCorners;
+    pose.view.cameraPoints = board->cameraCorners;
+    pose.view.projectorPoints = board->projectorCorners;
     std::array<Eigen::Vector2d, 4> rawCorners;
     for (std::size_t corner = 0; corner < rawCorners.size(); ++corner)
-        rawCorners[corner] = camera_.distortPixel(card.corners[corner]);
-    attempt.view.rectangleCorners = rawCorners;
-    attempt.accepted = true;
-    return attempt;
+        rawCorners[corner] = camera_.distortPixel(card->corners[corner]);
+    pose.view.rectangleCorners = rawCorners;
+    return pose;
 }
 
 }  // namespace everytouch::service

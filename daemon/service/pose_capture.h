@@ -12,6 +12,7 @@
 #include "core/frame.h"
 #include "core/plane_view.h"
 #include "core/projector_chessboard.h"
+#include "core/result.h"
 
 namespace everytouch::service {
 
@@ -70,10 +71,8 @@ private:
     double changedFraction_ = 0.0;
 };
 
-// What a still scene showed when it was offered as a new view.
-struct PoseAttempt {
-    bool accepted = false;
-    std::string problem;  // why not, in words for the user
+// A still scene that can be taken as a new view.
+struct Pose {
     core::PlaneView view;
     Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // the surface's, camera frame
 };
@@ -99,8 +98,9 @@ public:
     const std::vector<core::PlaneView>& views() const { return views_; }
     const std::string& problem() const { return problem_; }
 
-    // Looks at one still texture (8-bit gray or BGR) as the next view, without taking it.
-    PoseAttempt attempt(const cv::Mat& texture) const;
+    // Looks at one still texture (8-bit gray or BGR) as the next view, without taking it. Fails, in words for
+    // the user, when it cannot be taken.
+    core::Result<Pose> attempt(const cv::Mat& texture) const;
 
 private:
     PoseCaptureOptions options_;

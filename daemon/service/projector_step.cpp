@@ -48,7 +48,9 @@ std::string formatSeconds(double seconds) {
 EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     const PoseCaptureOptions captureOptions;
     const CalibrationOptions& options = context.options;
-    const cv::Size2d cardSizeMm(options.cardWidthMm, options.cardHeightMm);
+    const cv::Size2d cardSizeMm = cardRectangle(options).sizeMm;
+    if (const core::Status usable = checkDetectorOptions(options, context.projectorSize); !usable.ok())
+        return usable.failure();
     cv::Mat board;
     core::renderProjectorChessboard(tableSetUpChessboard(), context.projectorSize, board);
     context.show(board);
@@ -62,7 +64,7 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     while (!capture || capture->views().size() < options.views) {
         std::optional<std::vector<core::FramePair>> pairs = context.capture(1);
         if (!pairs || pairs->empty())
-            return EstimateResult::failed("it got no camera frames");
+            return core::Failure{"it got no camera frames"};
         const core::FramePair& pair = pairs->front();
         const std::int64_t nowUs = pair.latest().timestampUs;
         if (!capture) {
@@ -95,12 +97,12 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
                 break;
         }
         if ((nowUs - lastViewUs) * 1e-6 > options.viewTimeoutS)
-            return EstimateResult::failed(
-                "no pose " + std::to_string(pose) + " of " + std::to_string(options.views) +
-                " was taken within " + formatSeconds(options.viewTimeoutS) + " s (" +
-                (lastProblem.empty() ? std::string("the scene never held still with something new in view")
-                                     : "last seen: " + lastProblem) +
-                ")");
+            return core::Failure{"no pose " + std::to_string(pose) + " of " + std::to_string(options.views) +
+                                 " was taken within " + formatSeconds(options.viewTimeoutS) + " s (" +
+                                 (lastProblem.empty()
+                                      ? std::string("the scene never held still with something new in view")
+                                      : "last seen: " + lastProblem) +
+                                 ")"};
     }
 
     context.progress(viewShare * options.views, poseLabel(options.views, options.views) +
@@ -110,16 +112,17 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     pairOptions.cameraSize = cameraSize;
     pairOptions.projectorSize = context.projectorSize;
     pairOptions.rectangleSizeMm = cardSizeMm;
-    const core::PairCalibration pair = core::calibrateProjectorCameraPair(capture->views(), pairOptions);
-    if (!pair.success)
-        return EstimateResult::failed(pair.message);
+    const core::Result<core::PairCalibration> pair =
+        core::calibrateProjectorCameraPair(capture->views(), pairOptions);
+    if (!pair.ok())
+        return pair.failure();
 
     EstimateResult result =
-        calibrationOverTable(pair.pair, capture->views().front(), cardSizeMm,
+        calibrationOverTable(pair->pair, capture->views().front(), cardSizeMm,
                              context.current ? context.current->displaySize : context.projectorSize);
-    if (!result.calibration)
-        return EstimateResult::failed("the table in pose 1: " + result.problem);
-    result.rmsPx = pair.rmsPx.all;
+    if (!result.ok())
+        return core::Failure{"the table in pose 1: " + result.failure().message};
+    result->rmsPx = pair->rmsPx.all;
     return result;
 }
 

@@ -33,8 +33,8 @@ cv::Mat averageTexture(const std::vector<core::FramePair>& pairs) {
 }
 
 // Waits, pair by pair, until the scene has changed and then held still, and gives the still spell's average
-// texture (gray); the problem when it does not within the options' view time-out.
-std::optional<std::string> awaitNewStillScene(const StepContext& context, cv::Mat& stillTexture) {
+// texture (gray); fails when it does not within the options' view time-out.
+core::Result<cv::Mat> awaitNewStillScene(const StepContext& context) {
     StillnessTracker stillness{PoseCaptureOptions()};
     cv::Mat subtraction, texture, gray;
     bool changed = false;
@@ -42,11 +42,11 @@ std::optional<std::string> awaitNewStillScene(const StepContext& context, cv::Ma
     while (true) {
         const std::optional<std::vector<core::FramePair>> pairs = context.capture(1);
         if (!pairs || pairs->empty())
-            return "it got no camera frames";
+            return core::Failure{"it got no camera frames"};
         const core::FramePair& pair = pairs->front();
         core::computeSubtractionAndTexture(pair, subtraction, texture);
-        if (const std::optional<std::string> problem = core::grayFrame(texture, gray))
-            return "the camera frames: " + *problem;
+        if (const core::Status frame = core::grayFrame(texture, gray); !frame.ok())
+            return core::Failure{"the camera frames: " + frame.failure().message};
         const std::int64_t nowUs = pair.latest().timestampUs;
         const StillnessTracker::State state = stillness.offer(gray, nowUs);
         if (!startUs) {
@@ -55,12 +55,13 @@ std::optional<std::string> awaitNewStillScene(const StepContext& context, cv::Ma
         }
         changed = changed || state == StillnessTracker::State::Changed;
         if (changed && state == StillnessTracker::State::Still) {
+            cv::Mat stillTexture;
             stillness.average(stillTexture);
-            return std::nullopt;
+            return stillTexture;
         }
         if ((nowUs - *startUs) * 1e-6 > context.options.viewTimeoutS)
-            return "the scene did not change and hold still again within " +
-                   std::to_string(static_cast<int>(context.options.viewTimeoutS)) + " s";
+            return core::Failure{"the scene did not change and hold still again within " +
+                                 std::to_string(static_cast<int>(context.options.viewTimeoutS)) + " s"};
     }
 }
 
@@ -72,11 +73,28 @@ core::ChessboardOptions tableSetUpChessboard() {
     return options;
 }
 
+core::TableRectangleOptions cardRectangle(const CalibrationOptions& options) {
+    core::TableRectangleOptions card;
+    card.sizeMm = {options.cardWidthMm, options.cardHeightMm};
+    return card;
+}
+
+core::Status checkDetectorOptions(const CalibrationOptions& options, cv::Size projectorSize) {
+    if (const std::optional<std::string> problem = tableSetUpChessboard().validate(projectorSize))
+        return core::Failure{"the projected chessboard: " + *problem};
+    if (const std::optional<std::string> problem = cardRectangle(options).validate())
+        return core::Failure{"the card: " + *problem};
+    return {};
+}
+
 EstimateResult setUpTableStep(const StepContext& context) {
     if (!context.current)
-        return EstimateResult::failed(
+        return core::Failure{
             "it needs the projector-camera pair's calibration (both lenses and their pose), and "
-            "there is none; run the projector step first");
+            "there is none; run the projector step first"};
+    if (const core::Status usable = checkDetectorOptions(context.options, context.projectorSize);
+        !usable.ok())
+        return usable.failure();
     cv::Mat board;
     core::renderProjectorChessboard(tableSetUpChessboard(), context.projectorSize, board);
     context.show(board);
@@ -87,16 +105,16 @@ EstimateResult setUpTableStep(const StepContext& context) {
         // The scene still shows the previous step's last pose: wait until it has changed and holds still,
         // and use what it showed while still.
         context.progress(0.0, "Take the board away. " + prompt);
-        cv::Mat texture;
-        if (const std::optional<std::string> problem = awaitNewStillScene(context, texture))
-            return EstimateResult::failed(*problem);
+        const core::Result<cv::Mat> texture = awaitNewStillScene(context);
+        if (!texture.ok())
+            return texture.failure();
         context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
-        return setUpTableFromTexture(texture, *context.current, context.options);
+        return setUpTableFromTexture(texture.value(), *context.current, context.options);
     }
     context.progress(0.0, prompt);
     const std::optional<std::vector<core::FramePair>> pairs = context.capture(context.options.pairsPerStep);
     if (!pairs)
-        return EstimateResult::failed("it got no camera frames");
+        return core::Failure{"it got no camera frames"};
     context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
     return setUpTableFromPairs(*pairs, context.current, context.options);
 }
@@ -105,55 +123,55 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options) {
     if (!current)
-        return EstimateResult::failed(
+        return core::Failure{
             "it needs the projector-camera pair's calibration (both lenses and their pose), and "
-            "there is none");
+            "there is none"};
     if (pairs.empty())
-        return EstimateResult::failed("no frames");
+        return core::Failure{"no frames"};
     return setUpTableFromTexture(averageTexture(pairs), *current, options);
 }
 
 EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibration& current,
                                      const CalibrationOptions& options) {
+    if (const core::Status usable = checkDetectorOptions(options, current.projectorSize); !usable.ok())
+        return usable.failure();
     const core::ProjectorCameraPair pair = core::pairOf(current);
 
-    const core::ChessboardDetection board =
+    const core::Result<core::ChessboardDetection> board =
         core::detectProjectedChessboard(texture, tableSetUpChessboard(), current.projectorSize);
-    if (!board.success)
-        return EstimateResult::failed("the projected chessboard: " + board.message);
-    core::TableRectangleOptions cardOptions;
-    cardOptions.sizeMm = {options.cardWidthMm, options.cardHeightMm};
-    const core::TableRectangleDetection card = core::findTableRectangle(texture, cardOptions, pair.camera);
-    if (!card.success)
-        return EstimateResult::failed("the card: " + card.message);
+    if (!board.ok())
+        return core::Failure{"the projected chessboard: " + board.failure().message};
+    const core::Result<core::TableRectangleDetection> card =
+        core::findTableRectangle(texture, cardRectangle(options), pair.camera);
+    if (!card.ok())
+        return core::Failure{"the card: " + card.failure().message};
 
     core::PlaneView table;
-    table.cameraPoints = board.cameraCorners;
-    table.projectorPoints = board.projectorCorners;
+    table.cameraPoints = board->cameraCorners;
+    table.projectorPoints = board->projectorCorners;
     std::array<Eigen::Vector2d, 4> rawCorners;
     for (std::size_t corner = 0; corner < rawCorners.size(); ++corner)
-        rawCorners[corner] = pair.camera.distortPixel(card.corners[corner]);
+        rawCorners[corner] = pair.camera.distortPixel(card->corners[corner]);
     table.rectangleCorners = rawCorners;
-    return calibrationOverTable(pair, table, cardOptions.sizeMm, current.displaySize);
+    return calibrationOverTable(pair, table, cardRectangle(options).sizeMm, current.displaySize);
 }
 
 EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const core::PlaneView& table,
                                     cv::Size2d cardSizeMm, cv::Size displaySize) {
     core::TableSetupOptions setUpOptions;
     setUpOptions.rectangleSizeMm = cardSizeMm;
-    const core::TableSetup setUp = core::setUpTable(pair, table, setUpOptions);
-    if (!setUp.success)
-        return EstimateResult::failed(setUp.message);
+    const core::Result<core::TableSetup> setUp = core::setUpTable(pair, table, setUpOptions);
+    if (!setUp.ok())
+        return setUp.failure();
 
-    EstimateResult result;
-    result.calibration = setUp.calibration;
-    result.calibration->displaySize = displaySize;
-    const core::KeystoneFit keystone = core::fitDisplayToTable(*result.calibration, displaySize);
-    if (!keystone.success)
-        return EstimateResult::failed("fitting the display into the lit area: " + keystone.message);
-    result.calibration->displayToProjector = keystone.displayToProjector;
-    result.rmsPx = setUp.rmsPx.all;
-    return result;
+    Estimate estimate{setUp->calibration, setUp->rmsPx.all};
+    estimate.calibration.displaySize = displaySize;
+    const core::Result<core::KeystoneFit> keystone =
+        core::fitDisplayToTable(estimate.calibration, displaySize);
+    if (!keystone.ok())
+        return core::Failure{"fitting the display into the lit area: " + keystone.failure().message};
+    estimate.calibration.displayToProjector = keystone->displayToProjector;
+    return estimate;
 }
 
 }  // namespace everytouch::service

@@ -8,6 +8,8 @@
 #include "core/plane_view.h"
 #include "core/projector_camera_pair.h"
 #include "core/projector_chessboard.h"
+#include "core/result.h"
+#include "core/table_rectangle.h"
 #include "service/calibration_job.h"
 
 namespace everytouch::service {
@@ -16,6 +18,14 @@ namespace everytouch::service {
 // white border of a few centimetres stays around it on the table for the card (paper Section IV: one
 // projected chessboard and a card's stripe give the table).
 core::ChessboardOptions tableSetUpChessboard();
+
+// The card as the rectangle detector looks for it.
+core::TableRectangleOptions cardRectangle(const CalibrationOptions& options);
+
+// Whether the detectors can work with what a Calibrate call asked for: the board must fit a panel of
+// projectorSize and the card be given longer side first. The core detectors take usable options as given, so
+// the steps check here first and fail, saying which, instead.
+core::Status checkDetectorOptions(const CalibrationOptions& options, cv::Size projectorSize);
 
 // The "table" calibration step, the paper's quick set-up on top of the projector-camera pair known from
 // `current`: the texture of the captured pairs (averaged) shows the projected chessboard and the card's

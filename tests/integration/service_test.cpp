@@ -453,7 +453,7 @@ void expectProjectorGivenBack(const std::filesystem::path& dir, const core::Cali
         ASSERT_EQ(snapshot.exitCode, 0) << snapshot.err;
         const cv::Mat texture = cv::imread((dir / "after.png").string(), cv::IMREAD_UNCHANGED);
         if (!core::detectProjectedChessboard(texture, service::tableSetUpChessboard(), truth.projectorSize)
-                 .success)
+                 .ok())
             return;
     }
     ADD_FAILURE() << "the calibration chessboard is still projected after " << kSnapshots << " snapshots";

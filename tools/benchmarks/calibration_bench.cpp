@@ -131,11 +131,13 @@ void BM_ChessboardProjectorToCamera(benchmark::State& state) {
     const cv::Mat frame = cameraFrameOf(rig, board);
     const CameraModel camera{rig.cameraMatrix, rig.cameraDistortion};
     for (auto _ : state) {
-        const ProjectorToCameraEstimate estimate =
+        const Result<ProjectorToCameraEstimate> estimate =
             estimateProjectorToCamera(frame, options, rig.projectorSize, camera);
-        if (!estimate.success)
-            state.SkipWithError(estimate.message.c_str());
-        benchmark::DoNotOptimize(estimate.homography);
+        if (!estimate.ok()) {
+            state.SkipWithError(estimate.failure().message.c_str());
+            break;
+        }
+        benchmark::DoNotOptimize(estimate->homography);
     }
 }
 BENCHMARK(BM_ChessboardProjectorToCamera)->Unit(benchmark::kMillisecond);
@@ -145,7 +147,7 @@ void BM_ChessboardAbsent(benchmark::State& state) {
     const Calibration rig = benchRig();
     const cv::Mat frame = stripeFrame(rig);
     for (auto _ : state)
-        benchmark::DoNotOptimize(detectProjectedChessboard(frame, {}, rig.projectorSize).success);
+        benchmark::DoNotOptimize(detectProjectedChessboard(frame, {}, rig.projectorSize).ok());
 }
 BENCHMARK(BM_ChessboardAbsent)->Unit(benchmark::kMillisecond);
 
@@ -154,10 +156,12 @@ void BM_StripeTableToCamera(benchmark::State& state) {
     const Calibration rig = benchRig();
     const cv::Mat frame = stripeFrame(rig);
     for (auto _ : state) {
-        const TableRectangleDetection detection = findTableRectangle(frame, {});
-        if (!detection.success)
-            state.SkipWithError(detection.message.c_str());
-        benchmark::DoNotOptimize(detection.tableToCamera);
+        const Result<TableRectangleDetection> detection = findTableRectangle(frame, {});
+        if (!detection.ok()) {
+            state.SkipWithError(detection.failure().message.c_str());
+            break;
+        }
+        benchmark::DoNotOptimize(detection->tableToCamera);
     }
 }
 BENCHMARK(BM_StripeTableToCamera)->Unit(benchmark::kMillisecond);
@@ -172,10 +176,12 @@ void BM_PairCalibration(benchmark::State& state) {
     options.projectorSize = {640, 480};
     options.maxPointsPerView = static_cast<int>(state.range(0));
     for (auto _ : state) {
-        const PairCalibration calibration = calibrateProjectorCameraPair(views, options);
-        if (!calibration.success)
-            state.SkipWithError(calibration.message.c_str());
-        benchmark::DoNotOptimize(calibration.pair.camera.matrix);
+        const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, options);
+        if (!calibration.ok()) {
+            state.SkipWithError(calibration.failure().message.c_str());
+            break;
+        }
+        benchmark::DoNotOptimize(calibration->pair.camera.matrix);
     }
     state.counters["points_per_view"] =
         static_cast<double>(std::min<size_t>(views[0].cameraPoints.size(), state.range(0)));
@@ -188,10 +194,12 @@ void BM_TableSetup(benchmark::State& state) {
     const PlaneView table = exactView(rig, 60);
     const TableSetupOptions options;
     for (auto _ : state) {
-        const TableSetup setup = setUpTable(pairOf(rig), table, options);
-        if (!setup.success)
-            state.SkipWithError(setup.message.c_str());
-        benchmark::DoNotOptimize(setup.calibration.tableToCamera);
+        const Result<TableSetup> setup = setUpTable(pairOf(rig), table, options);
+        if (!setup.ok()) {
+            state.SkipWithError(setup.failure().message.c_str());
+            break;
+        }
+        benchmark::DoNotOptimize(setup->calibration.tableToCamera);
     }
 }
 BENCHMARK(BM_TableSetup)->Unit(benchmark::kMillisecond);
@@ -199,7 +207,7 @@ BENCHMARK(BM_TableSetup)->Unit(benchmark::kMillisecond);
 void BM_Keystone(benchmark::State& state) {
     const Calibration rig = benchRig();
     for (auto _ : state)
-        benchmark::DoNotOptimize(fitDisplayToTable(rig, {1280, 960}).displayToProjector);
+        benchmark::DoNotOptimize(fitDisplayToTable(rig, {1280, 960})->displayToProjector);
 }
 BENCHMARK(BM_Keystone)->Unit(benchmark::kMicrosecond);
 

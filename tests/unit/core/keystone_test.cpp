@@ -35,17 +35,17 @@ bool insidePanel(const Eigen::Vector2d& point, cv::Size panel) {
 }
 
 void expectUndistortedMaximalDisplay(const Calibration& rig, cv::Size display) {
-    const KeystoneFit fit = fitDisplayToTable(rig, display);
-    ASSERT_TRUE(fit.success) << fit.message;
+    const Result<KeystoneFit> fit = fitDisplayToTable(rig, display);
+    ASSERT_TRUE(fit.ok()) << fit.failure().message;
 
     // Inside the lit area.
-    for (const Eigen::Vector2d& corner : displayCornersOnPanel(fit.displayToProjector, display))
+    for (const Eigen::Vector2d& corner : displayCornersOnPanel(fit->displayToProjector, display))
         EXPECT_TRUE(insidePanel(corner, rig.projectorSize)) << corner.transpose();
 
     // Undistorted on the table: display pixels land on an axis-aligned grid of square cells.
     Calibration withDisplay = rig;
     withDisplay.displaySize = display;
-    withDisplay.displayToProjector = fit.displayToProjector;
+    withDisplay.displayToProjector = fit->displayToProjector;
     const Eigen::Matrix3d displayToTable = withDisplay.displayToTableHomography();
     const Eigen::Vector2d origin = applyHomography(displayToTable, {0, 0});
     const Eigen::Vector2d alongX = applyHomography(displayToTable, {display.width - 1.0, 0}) - origin;
@@ -59,21 +59,21 @@ void expectUndistortedMaximalDisplay(const Calibration& rig, cv::Size display) {
                 1e-9);  // square px
     const cv::Size2d sizeMm = withDisplay.displaySizeMm();
     EXPECT_NEAR(sizeMm.width / sizeMm.height, static_cast<double>(display.width) / display.height, 1e-9);
-    EXPECT_NEAR(sizeMm.width * sizeMm.height, fit.tableRectangleMm.volume(), 1e-6);  // where it says it is
+    EXPECT_NEAR(sizeMm.width * sizeMm.height, fit->tableRectangleMm.volume(), 1e-6);  // where it says it is
 
     // Maximal: grown by 1 % it leaves the lit area.
     bool leaves = false;
-    for (const Eigen::Vector2d& corner : displayCornersOnPanel(fit.displayToProjector, display, 1.01))
+    for (const Eigen::Vector2d& corner : displayCornersOnPanel(fit->displayToProjector, display, 1.01))
         leaves = leaves || !insidePanel(corner, rig.projectorSize);
     EXPECT_TRUE(leaves);
 
     // Not mirrored: the display keeps the projector's handedness.
     const Eigen::Vector2d centre =
-        applyHomography(fit.displayToProjector, {display.width / 2.0, display.height / 2.0});
+        applyHomography(fit->displayToProjector, {display.width / 2.0, display.height / 2.0});
     const Eigen::Vector2d right =
-        applyHomography(fit.displayToProjector, {display.width / 2.0 + 1, display.height / 2.0});
+        applyHomography(fit->displayToProjector, {display.width / 2.0 + 1, display.height / 2.0});
     const Eigen::Vector2d down =
-        applyHomography(fit.displayToProjector, {display.width / 2.0, display.height / 2.0 + 1});
+        applyHomography(fit->displayToProjector, {display.width / 2.0, display.height / 2.0 + 1});
     EXPECT_GT((right - centre).x() * (down - centre).y() - (right - centre).y() * (down - centre).x(), 0.0);
     EXPECT_GT((right - centre).x(), 0.0);  // and its x axis runs along the projector's
 }
@@ -81,7 +81,7 @@ void expectUndistortedMaximalDisplay(const Calibration& rig, cv::Size display) {
 TEST(Keystone, PaperLikeRigGetsTheLargestUndistortedDisplay) {
     expectUndistortedMaximalDisplay(test::paperLikeCalibration(), {1280, 960});
     const Eigen::Vector2d sizeMm =
-        fitDisplayToTable(test::paperLikeCalibration(), {1280, 960}).tableRectangleMm.sizes();
+        fitDisplayToTable(test::paperLikeCalibration(), {1280, 960})->tableRectangleMm.sizes();
     RecordProperty("display_width_mm", std::to_string(sizeMm.x()));
     RecordProperty("display_height_mm", std::to_string(sizeMm.y()));
 }
@@ -106,9 +106,9 @@ TEST(Keystone, FailsWhenTheImageDoesNotLandOnTheTable) {
     // Tilt the projector up by 60 degrees: its top rows look above the horizon.
     rig.tableToProjector =
         Eigen::AngleAxisd(-60 * M_PI / 180, Eigen::Vector3d::UnitX()) * rig.tableToProjector;
-    const KeystoneFit fit = fitDisplayToTable(rig, {1280, 960});
-    EXPECT_FALSE(fit.success);
-    EXPECT_THAT(fit.message, HasSubstr("never reaches the table"));
+    const Result<KeystoneFit> fit = fitDisplayToTable(rig, {1280, 960});
+    ASSERT_FALSE(fit.ok());
+    EXPECT_THAT(fit.failure().message, HasSubstr("never reaches the table"));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -79,16 +80,16 @@ TEST(PairCalibration, ExactCorrespondencesGiveTheExactPair) {
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
         views.push_back(exactView(test::onSurface(rig, pose), true));
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
-    ASSERT_TRUE(calibration.success) << calibration.message;
-    EXPECT_LT(calibration.rmsPx.all, 1e-6);
-    EXPECT_TRUE(calibration.pair.camera.matrix.isApprox(truth.camera.matrix, 1e-8));
-    EXPECT_TRUE(calibration.pair.camera.distortion.isApprox(truth.camera.distortion, 1e-6));
-    EXPECT_TRUE(calibration.pair.projectorMatrix.isApprox(truth.projectorMatrix, 1e-8));
-    EXPECT_TRUE(calibration.pair.cameraToProjector.isApprox(truth.cameraToProjector, 1e-8));
-    ASSERT_EQ(calibration.planes.size(), views.size());
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
+    ASSERT_TRUE(calibration.ok()) << calibration.failure().message;
+    EXPECT_LT(calibration->rmsPx.all, 1e-6);
+    EXPECT_TRUE(calibration->pair.camera.matrix.isApprox(truth.camera.matrix, 1e-8));
+    EXPECT_TRUE(calibration->pair.camera.distortion.isApprox(truth.camera.distortion, 1e-6));
+    EXPECT_TRUE(calibration->pair.projectorMatrix.isApprox(truth.projectorMatrix, 1e-8));
+    EXPECT_TRUE(calibration->pair.cameraToProjector.isApprox(truth.cameraToProjector, 1e-8));
+    ASSERT_EQ(calibration->planes.size(), views.size());
     // The table's distance from the camera: the scale the rectangle gives.
-    EXPECT_NEAR(calibration.planes[0].absDistance(Eigen::Vector3d::Zero()),
+    EXPECT_NEAR(calibration->planes[0].absDistance(Eigen::Vector3d::Zero()),
                 std::abs(rig.tableToCamera.translation().dot(rig.tableToCamera.rotation().col(2))), 1e-6);
 }
 
@@ -99,12 +100,12 @@ TEST(PairCalibration, DenseCorrespondencesAreThinnedAndViewsWithoutTheRectangleJ
         views.push_back(exactView(test::onSurface(rig, pose), views.size() < 4));
     PairCalibrationOptions options = optionsFor(rig);
     options.maxPointsPerView = 20;  // of 54
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, options);
-    ASSERT_TRUE(calibration.success) << calibration.message;
-    EXPECT_TRUE(calibration.pair.cameraToProjector.isApprox(pairOf(rig).cameraToProjector, 1e-8));
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, options);
+    ASSERT_TRUE(calibration.ok()) << calibration.failure().message;
+    EXPECT_TRUE(calibration->pair.cameraToProjector.isApprox(pairOf(rig).cameraToProjector, 1e-8));
     // The plane of a view without rectangle is found from its correspondences alone.
     const Calibration last = test::onSurface(rig, calibrationPoses().back());
-    EXPECT_NEAR(calibration.planes.back().absDistance(Eigen::Vector3d::Zero()),
+    EXPECT_NEAR(calibration->planes.back().absDistance(Eigen::Vector3d::Zero()),
                 std::abs(last.tableToCamera.translation().dot(last.tableToCamera.rotation().col(2))), 1e-6);
 }
 
@@ -113,9 +114,19 @@ TEST(PairCalibration, NeedsTheRectangleOnThreeSurfaces) {
     std::vector<PlaneView> views;
     for (const Eigen::Isometry3d& pose : calibrationPoses())
         views.push_back(exactView(test::onSurface(rig, pose), views.size() < 2));
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
-    EXPECT_FALSE(calibration.success);
-    EXPECT_THAT(calibration.message, HasSubstr("lies on 2 of the views"));
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
+    ASSERT_FALSE(calibration.ok());
+    EXPECT_THAT(calibration.failure().message, HasSubstr("lies on 2 of the views"));
+}
+
+TEST(PairCalibration, OptionsThatDoNotValidateAreAProgrammingError) {
+    const Calibration rig = test::distortedPaperLikeCalibration();
+    std::vector<PlaneView> views;
+    for (const Eigen::Isometry3d& pose : calibrationPoses())
+        views.push_back(exactView(test::onSurface(rig, pose), true));
+    PairCalibrationOptions options = optionsFor(rig);
+    options.maxRmsPx = 0.0;
+    EXPECT_THROW((void)calibrateProjectorCameraPair(views, options), std::invalid_argument);
 }
 
 TEST(PairCalibration, RectanglesOnParallelSurfacesAreNotEnough) {
@@ -124,9 +135,9 @@ TEST(PairCalibration, RectanglesOnParallelSurfacesAreNotEnough) {
     std::vector<PlaneView> views;
     for (double liftMm : {0.0, 30.0, 60.0, 90.0})
         views.push_back(exactView(test::onSurface(rig, test::tiltedBoard(0, 0, liftMm)), true));
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
-    EXPECT_FALSE(calibration.success);
-    EXPECT_THAT(calibration.message, HasSubstr("differ in tilt by 0.0 degrees"));
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
+    ASSERT_FALSE(calibration.ok());
+    EXPECT_THAT(calibration.failure().message, HasSubstr("differ in tilt by 0.0 degrees"));
 }
 
 TEST(PairCalibration, WrongCorrespondencesFailOnTheReprojectionError) {
@@ -136,9 +147,9 @@ TEST(PairCalibration, WrongCorrespondencesFailOnTheReprojectionError) {
         views.push_back(exactView(test::onSurface(rig, pose), true));
     // One view's board read with its rows upside down.
     std::reverse(views[2].projectorPoints.begin(), views[2].projectorPoints.end());
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
-    EXPECT_FALSE(calibration.success);
-    EXPECT_THAT(calibration.message, HasSubstr("RMS reprojection error"));
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
+    ASSERT_FALSE(calibration.ok());
+    EXPECT_THAT(calibration.failure().message, HasSubstr("RMS reprojection error"));
 }
 
 struct RenderedCase {
@@ -159,18 +170,18 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
     unsigned seed = 10;
     for (const Eigen::Isometry3d& pose : calibrationPoses()) {
         const Calibration surface = test::onSurface(rig, pose);
-        const test::CapturedView captured = test::captureView(
+        const Result<PlaneView> captured = test::captureView(
             surface, stripeInTheLight(surface), scenario.noiseSigmaDn, seed += 2, {}, calibrationBoard());
-        ASSERT_TRUE(captured.failure.empty()) << captured.failure;
-        views.push_back(captured.view);
+        ASSERT_TRUE(captured.ok()) << captured.failure().message;
+        views.push_back(captured.value());
     }
     const auto start = std::chrono::steady_clock::now();
-    const PairCalibration calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
+    const Result<PairCalibration> calibration = calibrateProjectorCameraPair(views, optionsFor(rig));
     const double elapsedMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    ASSERT_TRUE(calibration.success) << calibration.message;
-    const ProjectorCameraPair& found = calibration.pair;
-    const PairUncertainty& sigma = calibration.standardDeviation;
+    ASSERT_TRUE(calibration.ok()) << calibration.failure().message;
+    const ProjectorCameraPair& found = calibration->pair;
+    const PairUncertainty& sigma = calibration->standardDeviation;
 
     const double rotationErrorDeg =
         Eigen::AngleAxisd(found.cameraToProjector.rotation().transpose() * truth.cameraToProjector.rotation())
@@ -178,7 +189,7 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
         180.0 / M_PI;
     const double translationErrorMm =
         (found.cameraToProjector.translation() - truth.cameraToProjector.translation()).norm();
-    RecordProperty("rms_px", std::to_string(calibration.rmsPx.all));
+    RecordProperty("rms_px", std::to_string(calibration->rmsPx.all));
     RecordProperty("camera_focal_error_px",
                    std::to_string(found.camera.matrix(0, 0) - truth.camera.matrix(0, 0)));
     RecordProperty("camera_centre_error_px",
@@ -197,7 +208,7 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
     RecordProperty("sigma_projector_centre_px", std::to_string(sigma.projector.tail<2>().norm()));
     RecordProperty("elapsed_ms", std::to_string(elapsedMs));
 
-    EXPECT_LT(calibration.rmsPx.all, scenario.maxRmsPx);
+    EXPECT_LT(calibration->rmsPx.all, scenario.maxRmsPx);
     // The rectangle is the only metric information and it is small (about 140 x 16 camera pixels), so the
     // intrinsics are the least certain part: a focal length to about 0.5 % (1 sigma about 2-4 px), a
     // principal point to several pixels. The tolerances are about four of the estimator's own standard
@@ -213,13 +224,13 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
     // What matters downstream: after the quick set-up on the table with the recovered pair, the camera pixel
     // -> projector pixel map at the table and above it agrees with the truth across the lit area.
     const Calibration table = test::onSurface(rig, Eigen::Isometry3d::Identity());
-    const test::CapturedView tableView =
+    const Result<PlaneView> tableView =
         test::captureView(table, stripeInTheLight(table), scenario.noiseSigmaDn, 3, found.camera);
-    ASSERT_TRUE(tableView.failure.empty()) << tableView.failure;
-    const TableSetup setup = setUpTable(found, tableView.view, {});
-    ASSERT_TRUE(setup.success) << setup.message;
-    RecordProperty("table_setup_rms_px", std::to_string(setup.rmsPx.all));
-    EXPECT_LT(setup.rmsPx.all, scenario.maxRmsPx);
+    ASSERT_TRUE(tableView.ok()) << tableView.failure().message;
+    const Result<TableSetup> setup = setUpTable(found, tableView.value(), {});
+    ASSERT_TRUE(setup.ok()) << setup.failure().message;
+    RecordProperty("table_setup_rms_px", std::to_string(setup->rmsPx.all));
+    EXPECT_LT(setup->rmsPx.all, scenario.maxRmsPx);
     const Eigen::Isometry3d rectangleToTable =
         Eigen::Translation3d(stripeInTheLight(table).originMm.x(), stripeInTheLight(table).originMm.y(), 0) *
         Eigen::Isometry3d::Identity();
@@ -233,7 +244,7 @@ TEST_P(RenderedPoses, RecoverThePairAndTheMapsTouchDetectionUses) {
                 const Eigen::Vector2d expected =
                     projectorPixelSeenAt(truthInRectangleFrame, {x, y}, heightMm);
                 worstPx = std::max(
-                    worstPx, (projectorPixelSeenAt(setup.calibration, {x, y}, heightMm) - expected).norm());
+                    worstPx, (projectorPixelSeenAt(setup->calibration, {x, y}, heightMm) - expected).norm());
             }
         }
     }

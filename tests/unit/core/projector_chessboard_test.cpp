@@ -1,6 +1,7 @@
 #include "core/projector_chessboard.h"
 
 #include <chrono>
+#include <stdexcept>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -49,6 +50,13 @@ TEST(ProjectorChessboard, ValidateNamesTheProblem) {
     options = {};
     options.squarePx = 70;
     EXPECT_THAT(options.validate({640, 480}), Optional(HasSubstr("do not fit")));
+    // Options that do not validate are the caller's mistake, not something the frame shows.
+    cv::Mat board;
+    EXPECT_THROW(renderProjectorChessboard(options, {640, 480}, board), std::invalid_argument);
+    const cv::Mat frame(480, 640, CV_8UC1, cv::Scalar(200));
+    EXPECT_THROW((void)detectProjectedChessboard(frame, options, {640, 480}), std::invalid_argument);
+    EXPECT_THROW((void)estimateProjectorToCamera(frame, options, {640, 480}, CameraModel{}),
+                 std::invalid_argument);
 }
 
 class ProjectedChessboard : public ::testing::TestWithParam<double> {};
@@ -64,15 +72,15 @@ TEST_P(ProjectedChessboard, RecoversTheProjectorToCameraHomography) {
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
     const cv::Mat capture = test::renderSurface(scene, board, noiseSigmaDn);
 
-    const ProjectorToCameraEstimate estimate =
+    const Result<ProjectorToCameraEstimate> estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, CameraModel{});
-    ASSERT_TRUE(estimate.success) << estimate.message;
-    EXPECT_EQ(estimate.inliers, 54);
-    const double worst = worstCornerError(estimate.homography, scene.rig.projectorToCameraHomography(),
+    ASSERT_TRUE(estimate.ok()) << estimate.failure().message;
+    EXPECT_EQ(estimate->inliers, 54);
+    const double worst = worstCornerError(estimate->homography, scene.rig.projectorToCameraHomography(),
                                           projectorChessboardCorners(options, scene.rig.projectorSize));
-    RecordProperty("rms_px", std::to_string(estimate.rmsPx));
+    RecordProperty("rms_px", std::to_string(estimate->rmsPx));
     RecordProperty("worst_corner_error_px", std::to_string(worst));
-    EXPECT_LT(estimate.rmsPx, noiseSigmaDn > 0 ? 0.5 : 0.1);
+    EXPECT_LT(estimate->rmsPx, noiseSigmaDn > 0 ? 0.5 : 0.1);
     EXPECT_LT(worst, noiseSigmaDn > 0 ? 0.5 : 0.1);
 }
 
@@ -91,10 +99,10 @@ TEST(ProjectorChessboard, TellsTheBoardFromItsHalfTurn) {
     cv::Mat board;
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
     const cv::Mat capture = test::renderSurface(scene, board);
-    const ProjectorToCameraEstimate estimate =
+    const Result<ProjectorToCameraEstimate> estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, CameraModel{});
-    ASSERT_TRUE(estimate.success) << estimate.message;
-    EXPECT_LT(worstCornerError(estimate.homography, scene.rig.projectorToCameraHomography(),
+    ASSERT_TRUE(estimate.ok()) << estimate.failure().message;
+    EXPECT_LT(worstCornerError(estimate->homography, scene.rig.projectorToCameraHomography(),
                                projectorChessboardCorners(options, scene.rig.projectorSize)),
               0.1);
 }
@@ -108,11 +116,11 @@ TEST(ProjectorChessboard, UndistortsTheCornersWithTheCameraModel) {
     renderProjectorChessboard(options, scene.rig.projectorSize, board);
     const cv::Mat capture = test::renderSurface(scene, board);
     const CameraModel camera{scene.rig.cameraMatrix, scene.rig.cameraDistortion};
-    const ProjectorToCameraEstimate estimate =
+    const Result<ProjectorToCameraEstimate> estimate =
         estimateProjectorToCamera(capture, options, scene.rig.projectorSize, camera);
-    ASSERT_TRUE(estimate.success) << estimate.message;
-    EXPECT_LT(estimate.rmsPx, 0.1);
-    EXPECT_LT(worstCornerError(estimate.homography, scene.rig.projectorToCameraHomography(),
+    ASSERT_TRUE(estimate.ok()) << estimate.failure().message;
+    EXPECT_LT(estimate->rmsPx, 0.1);
+    EXPECT_LT(worstCornerError(estimate->homography, scene.rig.projectorToCameraHomography(),
                                projectorChessboardCorners(options, scene.rig.projectorSize)),
               0.1);
 }
@@ -124,11 +132,12 @@ TEST(ProjectorChessboard, FrameWithoutABoardFailsQuickly) {
     const cv::Mat white(scene.rig.projectorSize, CV_8UC1, cv::Scalar(255));
     const cv::Mat capture = test::renderSurface(scene, white, 2.0);
     const auto start = std::chrono::steady_clock::now();
-    const ChessboardDetection detection = detectProjectedChessboard(capture, {}, scene.rig.projectorSize);
+    const Result<ChessboardDetection> detection =
+        detectProjectedChessboard(capture, {}, scene.rig.projectorSize);
     const double elapsedMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    EXPECT_FALSE(detection.success);
-    EXPECT_THAT(detection.message, HasSubstr("no projected chessboard"));
+    ASSERT_FALSE(detection.ok());
+    EXPECT_THAT(detection.failure().message, HasSubstr("no projected chessboard"));
     // Without CALIB_CB_FAST_CHECK the classic finder spends about 7 s on such a frame; with it a few ms (tens
     // under the sanitizers). The bound separates the two on a loaded machine.
     EXPECT_LT(elapsedMs, 500.0);
@@ -136,7 +145,7 @@ TEST(ProjectorChessboard, FrameWithoutABoardFailsQuickly) {
 
 TEST(ProjectorChessboard, RejectsAnImageOfTheWrongType) {
     const cv::Mat floating(488, 648, CV_32FC1, cv::Scalar(0.5));
-    EXPECT_THAT(detectProjectedChessboard(floating, {}, {640, 480}).message, HasSubstr("8-bit"));
+    EXPECT_THAT(detectProjectedChessboard(floating, {}, {640, 480}).failure().message, HasSubstr("8-bit"));
 }
 
 }  // namespace

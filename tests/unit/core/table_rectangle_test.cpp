@@ -1,5 +1,7 @@
 #include "core/table_rectangle.h"
 
+#include <stdexcept>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -60,14 +62,14 @@ TEST_P(StripeOnTable, FindsTheCornersToAFractionOfAPixel) {
     const double noiseSigmaDn = GetParam();
     const test::SurfaceScene scene = stripeOnTable();
     const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), noiseSigmaDn);
-    const TableRectangleDetection detection = findTableRectangle(capture, {});
-    ASSERT_TRUE(detection.success) << detection.message;
-    const double worst = worstCornerError(detection, trueCorners(scene, scene.rectangles[0]));
+    const Result<TableRectangleDetection> detection = findTableRectangle(capture, {});
+    ASSERT_TRUE(detection.ok()) << detection.failure().message;
+    const double worst = worstCornerError(detection.value(), trueCorners(scene, scene.rectangles[0]));
     RecordProperty("worst_corner_error_px", std::to_string(worst));
     EXPECT_LT(worst, noiseSigmaDn > 0 ? 0.2 : 0.05);
-    EXPECT_GT(detection.contrastDn, 100);
+    EXPECT_GT(detection->contrastDn, 100);
     // The homography takes the table's stripe corners to the corners found.
-    EXPECT_LT((applyHomography(detection.tableToCamera, {85.5, 12.5}) - detection.corners[2]).norm(), 1e-6);
+    EXPECT_LT((applyHomography(detection->tableToCamera, {85.5, 12.5}) - detection->corners[2]).norm(), 1e-6);
 }
 
 INSTANTIATE_TEST_SUITE_P(NoiseFreeAndNoisy, StripeOnTable, ::testing::Values(0.0, 2.0));
@@ -84,9 +86,9 @@ TEST(TableRectangle, IgnoresDarkThingsOfOtherShapes) {
     cardSized.albedo = 0.3;
     scene.rectangles.insert(scene.rectangles.end(), {square, line, cardSized});
     const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
-    const TableRectangleDetection detection = findTableRectangle(capture, {});
-    ASSERT_TRUE(detection.success) << detection.message;
-    EXPECT_LT(worstCornerError(detection, trueCorners(scene, scene.rectangles[0])), 0.2);
+    const Result<TableRectangleDetection> detection = findTableRectangle(capture, {});
+    ASSERT_TRUE(detection.ok()) << detection.failure().message;
+    EXPECT_LT(worstCornerError(detection.value(), trueCorners(scene, scene.rectangles[0])), 0.2);
 }
 
 TEST(TableRectangle, FindsAWholeDarkCardGivenItsSize) {
@@ -100,28 +102,42 @@ TEST(TableRectangle, FindsAWholeDarkCardGivenItsSize) {
     const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
     TableRectangleOptions options;
     options.sizeMm = card.sizeMm;
-    const TableRectangleDetection detection = findTableRectangle(capture, options);
-    ASSERT_TRUE(detection.success) << detection.message;
-    EXPECT_LT(worstCornerError(detection, trueCorners(scene, card)), 0.2);
+    const Result<TableRectangleDetection> detection = findTableRectangle(capture, options);
+    ASSERT_TRUE(detection.ok()) << detection.failure().message;
+    EXPECT_LT(worstCornerError(detection.value(), trueCorners(scene, card)), 0.2);
 }
 
 TEST(TableRectangle, ReportsUndistortedPixelsOfTheCameraModel) {
     test::SurfaceScene scene = stripeOnTable();
     scene.rig.cameraDistortion << -0.2, 0.1, 0, 0, 0;
     const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig));
-    const TableRectangleDetection detection =
+    const Result<TableRectangleDetection> detection =
         findTableRectangle(capture, {}, CameraModel{scene.rig.cameraMatrix, scene.rig.cameraDistortion});
-    ASSERT_TRUE(detection.success) << detection.message;
-    EXPECT_LT(worstCornerError(detection, trueCorners(scene, scene.rectangles[0])), 0.05);
+    ASSERT_TRUE(detection.ok()) << detection.failure().message;
+    EXPECT_LT(worstCornerError(detection.value(), trueCorners(scene, scene.rectangles[0])), 0.05);
 }
 
 TEST(TableRectangle, TableWithoutTheRectangleFailsWithAMessage) {
     test::SurfaceScene scene;
     scene.rig = test::paperLikeCalibration();
     const cv::Mat capture = test::renderSurface(scene, whiteProjection(scene.rig), 2.0);
-    const TableRectangleDetection detection = findTableRectangle(capture, {});
-    EXPECT_FALSE(detection.success);
-    EXPECT_THAT(detection.message, HasSubstr("no dark rectangle of 85.5 x 12.5 mm"));
+    const Result<TableRectangleDetection> detection = findTableRectangle(capture, {});
+    ASSERT_FALSE(detection.ok());
+    EXPECT_THAT(detection.failure().message, HasSubstr("no dark rectangle of 85.5 x 12.5 mm"));
+}
+
+TEST(TableRectangle, OptionsThatDoNotValidateAreAProgrammingError) {
+    TableRectangleOptions options;
+    options.sizeMm = {12.5, 85.5};
+    EXPECT_THAT(options.validate(), ::testing::Optional(HasSubstr("longer side first")));
+    EXPECT_THROW((void)findTableRectangle(cv::Mat(48, 64, CV_8UC1, cv::Scalar(200)), options),
+                 std::invalid_argument);
+}
+
+TEST(TableRectangle, AFrameThatIsNeitherGrayNorBgrFails) {
+    const Result<TableRectangleDetection> detection = findTableRectangle(cv::Mat(48, 64, CV_32FC1), {});
+    ASSERT_FALSE(detection.ok());
+    EXPECT_THAT(detection.failure().message, HasSubstr("8-bit gray or BGR"));
 }
 
 }  // namespace

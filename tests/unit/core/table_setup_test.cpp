@@ -1,5 +1,7 @@
 #include "core/table_setup.h"
 
+#include <stdexcept>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -63,12 +65,12 @@ TEST(TableSetup, ExactCorrespondencesGiveTheExactTable) {
         corners[corner] = pair.camera.project(truth * local[corner]);
     view.rectangleCorners = corners;
 
-    const TableSetup setup = setUpTable(pair, view, {});
-    ASSERT_TRUE(setup.success) << setup.message;
-    EXPECT_LT(setup.rmsPx.all, 1e-6);
-    EXPECT_LT(rotationErrorDeg(setup.calibration.tableToCamera, truth), 1e-6);
-    EXPECT_LT((setup.calibration.tableToCamera.translation() - truth.translation()).norm(), 1e-6);
-    EXPECT_EQ(setup.calibration.validate(),
+    const Result<TableSetup> setup = setUpTable(pair, view, {});
+    ASSERT_TRUE(setup.ok()) << setup.failure().message;
+    EXPECT_LT(setup->rmsPx.all, 1e-6);
+    EXPECT_LT(rotationErrorDeg(setup->calibration.tableToCamera, truth), 1e-6);
+    EXPECT_LT((setup->calibration.tableToCamera.translation() - truth.translation()).norm(), 1e-6);
+    EXPECT_EQ(setup->calibration.validate(),
               std::optional<std::string>("display_size: width and height must be positive"));
 }
 
@@ -80,18 +82,19 @@ TEST_P(RenderedTable, RecoversTheTableFrameFromTheStripe) {
     const double noiseSigmaDn = GetParam();
     const Calibration rig = distortedRig();
     const ProjectorCameraPair pair = pairOf(rig);
-    const test::CapturedView captured = test::captureView(rig, stripe(), noiseSigmaDn, 7, pair.camera);
-    ASSERT_TRUE(captured.failure.empty()) << captured.failure;
+    const Result<PlaneView> captured = test::captureView(rig, stripe(), noiseSigmaDn, 7, pair.camera);
+    ASSERT_TRUE(captured.ok()) << captured.failure().message;
 
-    const TableSetup setup = setUpTable(pair, captured.view, {});
-    ASSERT_TRUE(setup.success) << setup.message;
+    const Result<TableSetup> setup = setUpTable(pair, captured.value(), {});
+    ASSERT_TRUE(setup.ok()) << setup.failure().message;
     const Eigen::Isometry3d truth = rectangleToCamera(rig, stripe());
-    const double rotationDeg = rotationErrorDeg(setup.calibration.tableToCamera, truth);
-    const double translationMm = (setup.calibration.tableToCamera.translation() - truth.translation()).norm();
-    RecordProperty("rms_px", std::to_string(setup.rmsPx.all));
+    const double rotationDeg = rotationErrorDeg(setup->calibration.tableToCamera, truth);
+    const double translationMm =
+        (setup->calibration.tableToCamera.translation() - truth.translation()).norm();
+    RecordProperty("rms_px", std::to_string(setup->rmsPx.all));
     RecordProperty("rotation_error_deg", std::to_string(rotationDeg));
     RecordProperty("translation_error_mm", std::to_string(translationMm));
-    EXPECT_LT(setup.rmsPx.all, noiseSigmaDn > 0 ? 0.5 : 0.1);
+    EXPECT_LT(setup->rmsPx.all, noiseSigmaDn > 0 ? 0.5 : 0.1);
     EXPECT_LT(rotationDeg, 0.2);
     EXPECT_LT(translationMm, 0.5);
     // What the pipeline uses: table millimetres -> projector pixels, checked across the lit area.
@@ -101,7 +104,7 @@ TEST_P(RenderedTable, RecoversTheTableFrameFromTheStripe) {
         const Eigen::Vector3d onTable(pointMm.x(), pointMm.y(), 0);
         const Eigen::Vector2d expected = projectPoint(rig.projectorMatrix, truthToProjector, onTable);
         const Eigen::Vector2d found =
-            projectPoint(setup.calibration.projectorMatrix, setup.calibration.tableToProjector, onTable);
+            projectPoint(setup->calibration.projectorMatrix, setup->calibration.tableToProjector, onTable);
         EXPECT_LT((found - expected).norm(), 0.5) << pointMm.transpose();
     }
 }
@@ -110,23 +113,29 @@ INSTANTIATE_TEST_SUITE_P(NoiseFreeAndNoisy, RenderedTable, ::testing::Values(0.0
 
 TEST(TableSetup, WithoutTheRectangleSaysSo) {
     const Calibration rig = distortedRig();
-    const test::CapturedView captured = test::captureView(rig, std::nullopt, 0.0, 1);
-    ASSERT_TRUE(captured.failure.empty()) << captured.failure;
-    const TableSetup setup = setUpTable(pairOf(rig), captured.view, {});
-    EXPECT_FALSE(setup.success);
-    EXPECT_THAT(setup.message, HasSubstr("rectangle was not found"));
+    const Result<PlaneView> captured = test::captureView(rig, std::nullopt, 0.0, 1);
+    ASSERT_TRUE(captured.ok()) << captured.failure().message;
+    const Result<TableSetup> setup = setUpTable(pairOf(rig), captured.value(), {});
+    ASSERT_FALSE(setup.ok());
+    EXPECT_THAT(setup.failure().message, HasSubstr("rectangle was not found"));
+}
+
+TEST(TableSetup, OptionsThatDoNotValidateAreAProgrammingError) {
+    TableSetupOptions options;
+    options.maxRmsPx = 0.0;
+    EXPECT_THROW((void)setUpTable(pairOf(distortedRig()), PlaneView{}, options), std::invalid_argument);
 }
 
 TEST(TableSetup, APairThatNoLongerFitsFailsOnTheReprojectionError) {
     // The projector was knocked 2 degrees since the pair was calibrated.
     const Calibration rig = distortedRig();
-    const test::CapturedView captured = test::captureView(rig, stripe(), 0.0, 1, pairOf(rig).camera);
-    ASSERT_TRUE(captured.failure.empty()) << captured.failure;
+    const Result<PlaneView> captured = test::captureView(rig, stripe(), 0.0, 1, pairOf(rig).camera);
+    ASSERT_TRUE(captured.ok()) << captured.failure().message;
     ProjectorCameraPair knocked = pairOf(rig);
     knocked.cameraToProjector.prerotate(Eigen::AngleAxisd(2 * M_PI / 180, Eigen::Vector3d::UnitY()));
-    const TableSetup setup = setUpTable(knocked, captured.view, {});
-    EXPECT_FALSE(setup.success);
-    EXPECT_THAT(setup.message, HasSubstr("RMS reprojection error"));
+    const Result<TableSetup> setup = setUpTable(knocked, captured.value(), {});
+    ASSERT_FALSE(setup.ok());
+    EXPECT_THAT(setup.failure().message, HasSubstr("RMS reprojection error"));
 }
 
 }  // namespace

@@ -33,14 +33,14 @@ TEST(SimProjector, TheSimulatedCameraSeesWhatItShowsUntilReleased) {
     SimProjector projector(source);
     EXPECT_EQ(projector.size(), source.rig()->calibration.projectorSize);
     EXPECT_THAT(projector.describe(), ::testing::HasSubstr("simulated projector"));
-    EXPECT_FALSE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).success);
+    EXPECT_FALSE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).ok());
 
     cv::Mat image;
     core::renderProjectorChessboard(board(), projector.size(), image);
     projector.show(image);
-    EXPECT_TRUE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).success);
+    EXPECT_TRUE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).ok());
     projector.release();
-    EXPECT_FALSE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).success);
+    EXPECT_FALSE(core::detectProjectedChessboard(nextTexture(source), board(), projector.size()).ok());
 
     EXPECT_THROW(projector.show(cv::Mat(10, 10, CV_8UC1)), std::invalid_argument);
 }

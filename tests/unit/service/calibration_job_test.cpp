@@ -29,22 +29,19 @@ std::vector<core::FramePair> pairsNumbered(std::size_t count, std::uint64_t firs
 // chained through.
 CalibrationStep shiftingStep(const std::string& name, double shift, double rmsPx,
                              std::vector<std::size_t>& pairsSeen) {
-    return {name, name + " description", [name, shift, rmsPx, &pairsSeen](const StepContext& context) {
-                EstimateResult result;
+    return {name, name + " description",
+            [name, shift, rmsPx, &pairsSeen](const StepContext& context) -> EstimateResult {
                 context.show(cv::Mat(context.projectorSize, CV_8UC1, cv::Scalar(255)));
                 context.progress(0.0, name + " prompt");
                 const std::optional<std::vector<core::FramePair>> pairs =
                     context.capture(context.options.pairsPerStep);
-                if (!pairs) {
-                    result.problem = "no frames";
-                    return result;
-                }
+                if (!pairs)
+                    return core::Failure{"no frames"};
                 pairsSeen.push_back(pairs->size());
                 context.progress(0.5, name + " estimating");
-                result.calibration = context.current.value_or(test::paperLikeCalibration());
-                result.calibration->displayToProjector(0, 2) += shift;
-                result.rmsPx = rmsPx;
-                return result;
+                Estimate estimate{context.current.value_or(test::paperLikeCalibration()), rmsPx};
+                estimate.calibration.displayToProjector(0, 2) += shift;
+                return estimate;
             }};
 }
 
@@ -114,11 +111,7 @@ TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
 TEST(CalibrationJob, AFailingStepStopsTheJobWithoutACalibration) {
     std::vector<std::size_t> pairsSeen;
     CalibrationStep failing = shiftingStep("first", 1.0, 0.2, pairsSeen);
-    failing.run = [](const StepContext&) {
-        EstimateResult result;
-        result.problem = "no chessboard in view";
-        return result;
-    };
+    failing.run = [](const StepContext&) -> EstimateResult { return core::Failure{"no chessboard in view"}; };
     const std::vector<CalibrationStep> steps = {failing, shiftingStep("second", 10.0, 0.4, pairsSeen)};
     const CalibrationOutcome outcome = runCalibration(
         steps, CalibrationOptions(), test::paperLikeCalibration(), cv::Size(640, 480),

@@ -109,13 +109,13 @@ private:
 
 // A step that shows a white image, then captures `pairs` pairs and notes the newer frame of the first.
 CalibrationStep capturingStep(std::size_t pairs, std::atomic<std::uint64_t>& firstCaptured) {
-    return {"table", "the test step", [pairs, &firstCaptured](const StepContext& context) {
+    return {"table", "the test step", [pairs, &firstCaptured](const StepContext& context) -> EstimateResult {
                 context.show(cv::Mat(context.projectorSize, CV_8UC1, cv::Scalar(255)));
                 const std::optional<std::vector<core::FramePair>> captured = context.capture(pairs);
                 if (!captured)
-                    return EstimateResult::failed("no frames");
+                    return core::Failure{"no frames"};
                 firstCaptured = captured->front().latest().index;
-                return EstimateResult{test::paperLikeCalibration(), 0.25, ""};
+                return Estimate{test::paperLikeCalibration(), 0.25};
             }};
 }
 

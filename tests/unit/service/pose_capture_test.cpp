@@ -131,10 +131,10 @@ TEST(StillnessTracker, AStillSceneBecomesStillAfterTheSpellAndAMovingOneNever) {
 
 TEST(PoseCapture, TakesATiltedPoseAndRefusesOneLikeAPoseTakenBefore) {
     PoseCapture capture = captureFor();
-    const PoseAttempt table = capture.attempt(poseImage(0, 1));
-    ASSERT_TRUE(table.accepted) << table.problem;
-    EXPECT_EQ(table.view.cameraPoints.size(), 54u);
-    EXPECT_TRUE(table.view.rectangleCorners);
+    const core::Result<Pose> table = capture.attempt(poseImage(0, 1));
+    ASSERT_TRUE(table.ok()) << table.failure().message;
+    EXPECT_EQ(table->view.cameraPoints.size(), 54u);
+    EXPECT_TRUE(table->view.rectangleCorners);
 
     std::vector<core::FramePair> pairs;
     holdStill(pairs, 0, 1.0);
@@ -160,12 +160,14 @@ TEST(PoseCapture, TakesATiltedPoseAndRefusesOneLikeAPoseTakenBefore) {
 TEST(PoseCapture, SaysWhatIsMissing) {
     PoseCapture capture = captureFor();
     const cv::Mat blank(poseImage(0, 1).size(), CV_8UC1, cv::Scalar(200));
-    EXPECT_THAT(capture.attempt(blank).problem, HasSubstr("the projected chessboard is not in view"));
+    EXPECT_THAT(capture.attempt(blank).failure().message,
+                HasSubstr("the projected chessboard is not in view"));
     cv::Mat withoutCard = poseImage(0, 1).clone();
     const core::Calibration rig = test::distortedPaperLikeCalibration();
     const Eigen::Vector2d card = core::applyHomography(rig.projectorToCameraHomography(), {320, 420});
     cv::circle(withoutCard, cv::Point(int(card.x()), int(card.y())), 60, cv::Scalar(200), cv::FILLED);
-    EXPECT_THAT(capture.attempt(withoutCard).problem, HasSubstr("the card's stripe is not in view"));
+    EXPECT_THAT(capture.attempt(withoutCard).failure().message,
+                HasSubstr("the card's stripe is not in view"));
 }
 
 struct StepRun {
@@ -176,7 +178,8 @@ struct StepRun {
 
 StepRun runStep(const std::vector<core::FramePair>& pairs, const CalibrationOptions& options,
                 const std::optional<core::Calibration>& current) {
-    StepRun run;
+    std::vector<std::pair<double, std::string>> progress;
+    std::vector<cv::Size> shown;
     std::size_t next = 0;
     const StepContext context{
         options,
@@ -189,10 +192,10 @@ StepRun runStep(const std::vector<core::FramePair>& pairs, const CalibrationOpti
             return std::vector<core::FramePair>(pairs.begin() + static_cast<std::ptrdiff_t>(next - count),
                                                 pairs.begin() + static_cast<std::ptrdiff_t>(next));
         },
-        [&](const cv::Mat& image) { run.shown.push_back(image.size()); },
-        [&](double fraction, const std::string& message) { run.progress.emplace_back(fraction, message); }};
-    run.result = calibrateProjectorCameraPairStep(context);
-    return run;
+        [&](const cv::Mat& image) { shown.push_back(image.size()); },
+        [&](double fraction, const std::string& message) { progress.emplace_back(fraction, message); }};
+    EstimateResult result = calibrateProjectorCameraPairStep(context);
+    return {std::move(result), std::move(progress), std::move(shown)};
 }
 
 TEST(ProjectorStep, CalibratesThePairFromTheTableAndFiveTiltsTakenByThemselves) {
@@ -202,8 +205,8 @@ TEST(ProjectorStep, CalibratesThePairFromTheTableAndFiveTiltsTakenByThemselves) 
         move(pairs, pose, 0.2);
     }
     const StepRun run = runStep(pairs, CalibrationOptions(), std::nullopt);
-    ASSERT_TRUE(run.result.calibration) << run.result.problem;
-    EXPECT_LE(run.result.rmsPx, 0.5);
+    ASSERT_TRUE(run.result.ok()) << run.result.failure().message;
+    EXPECT_LE(run.result->rmsPx, 0.5);
     EXPECT_EQ(run.shown, std::vector<cv::Size>{test::distortedPaperLikeCalibration().projectorSize});
     ASSERT_FALSE(run.progress.empty());
     EXPECT_THAT(run.progress.front().second, HasSubstr("Pose 1 of 6: lay the card on the table"));
@@ -215,7 +218,7 @@ TEST(ProjectorStep, CalibratesThePairFromTheTableAndFiveTiltsTakenByThemselves) 
 
     // The map touch detection relies on, camera pixel -> projector pixel on the table, as the truth's.
     const core::Calibration truth = test::distortedPaperLikeCalibration();
-    const core::Calibration& found = *run.result.calibration;
+    const core::Calibration& found = run.result->calibration;
     double worstPx = 0;
     for (double x = 60; x <= 580; x += 40)
         for (double y = 60; y <= 420; y += 40) {
@@ -236,8 +239,8 @@ TEST(ProjectorStep, FailsClearlyWhenNoNewPoseComesInTime) {
     CalibrationOptions options;
     options.viewTimeoutS = 2.0;
     const StepRun run = runStep(pairs, options, test::distortedPaperLikeCalibration());
-    ASSERT_FALSE(run.result.calibration);
-    EXPECT_EQ(run.result.problem,
+    ASSERT_FALSE(run.result.ok());
+    EXPECT_EQ(run.result.failure().message,
               "no pose 2 of 6 was taken within 2 s (the scene never held still with something new in view)");
 }
 

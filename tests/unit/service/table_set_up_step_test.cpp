@@ -51,9 +51,9 @@ TEST(TableSetUpStep, RecoversTheTableAndFitsTheDisplay) {
     const core::Calibration rig = distortedRig();
     const test::DarkRectangle card = stripeBelowTheBoard(rig);
     const EstimateResult result = setUpTableFromPairs(capturedPairs(rig, card, 4, 2.0), rig, {});
-    ASSERT_TRUE(result.calibration) << result.problem;
-    EXPECT_LT(result.rmsPx, 0.5);
-    EXPECT_FALSE(result.calibration->validate()) << *result.calibration->validate();
+    ASSERT_TRUE(result.ok()) << result.failure().message;
+    EXPECT_LT(result->rmsPx, 0.5);
+    EXPECT_FALSE(result->calibration.validate()) << *result->calibration.validate();
     // The found table frame is the card's. What the pipeline needs is where table points land in both
     // devices: checked across the lit area against the truth.
     const Eigen::Isometry3d cardToTable(Eigen::Translation3d(card.originMm.x(), card.originMm.y(), 0));
@@ -65,7 +65,7 @@ TEST(TableSetUpStep, RecoversTheTableAndFitsTheDisplay) {
         const Eigen::Vector3d onCard = cardToTable.inverse() * Eigen::Vector3d(onTable.x(), onTable.y(), 0);
         const Eigen::Vector2d cameraTruth = core::projectPoint(rig.cameraMatrix, rig.tableToCamera,
                                                                Eigen::Vector3d(onTable.x(), onTable.y(), 0));
-        const core::Calibration& found = *result.calibration;
+        const core::Calibration& found = result->calibration;
         EXPECT_LT((core::projectPoint(found.projectorMatrix, found.tableToProjector, onCard) - projectorPixel)
                       .norm(),
                   0.5)
@@ -74,20 +74,38 @@ TEST(TableSetUpStep, RecoversTheTableAndFitsTheDisplay) {
                   0.5)
             << projectorPixel.transpose();
     }
-    EXPECT_EQ(result.calibration->displaySize, rig.displaySize);
+    EXPECT_EQ(result->calibration.displaySize, rig.displaySize);
 }
 
 TEST(TableSetUpStep, SaysWhatIsMissing) {
     const core::Calibration rig = distortedRig();
-    EXPECT_THAT(setUpTableFromPairs(capturedPairs(rig, std::nullopt, 1, 0.0), rig, {}).problem,
+    EXPECT_THAT(setUpTableFromPairs(capturedPairs(rig, std::nullopt, 1, 0.0), rig, {}).failure().message,
                 HasSubstr("the card: "));
-    EXPECT_THAT(
-        setUpTableFromPairs(capturedPairs(rig, stripeBelowTheBoard(rig), 1, 0.0), std::nullopt, {}).problem,
-        HasSubstr("needs the projector-camera pair's calibration"));
+    EXPECT_THAT(setUpTableFromPairs(capturedPairs(rig, stripeBelowTheBoard(rig), 1, 0.0), std::nullopt, {})
+                    .failure()
+                    .message,
+                HasSubstr("needs the projector-camera pair's calibration"));
     std::vector<core::FramePair> blank(1);
     blank[0].positive.image = cv::Mat(rig.cameraSize, CV_8UC1, cv::Scalar(180));
     blank[0].negative.image = blank[0].positive.image;
-    EXPECT_THAT(setUpTableFromPairs(blank, rig, {}).problem, HasSubstr("the projected chessboard: "));
+    EXPECT_THAT(setUpTableFromPairs(blank, rig, {}).failure().message,
+                HasSubstr("the projected chessboard: "));
+}
+
+TEST(TableSetUpStep, RefusesOptionsTheDetectorsCannotWorkWith) {
+    const core::Calibration rig = distortedRig();
+    CalibrationOptions upright;
+    upright.cardWidthMm = 12.5;
+    upright.cardHeightMm = 85.5;
+    EXPECT_EQ(checkDetectorOptions(upright, rig.projectorSize).failure().message,
+              "the card: rectangle size_mm: give the longer side first");
+    EXPECT_EQ(setUpTableFromPairs(capturedPairs(rig, stripeBelowTheBoard(rig), 1, 0.0), rig, upright)
+                  .failure()
+                  .message,
+              "the card: rectangle size_mm: give the longer side first");
+    EXPECT_THAT(checkDetectorOptions({}, {320, 240}).failure().message,
+                HasSubstr("the projected chessboard: chessboard square_px"));
+    EXPECT_TRUE(checkDetectorOptions({}, rig.projectorSize).ok());
 }
 
 }  // namespace
@@ -148,11 +166,12 @@ TEST(TableSetUpStep, AfterAnotherStepWaitsUntilTheBoardIsTakenAway) {
         capturedPairs(test::onSurface(rig, tilt), std::nullopt, 1, 2.0);
     const std::vector<core::FramePair> table = capturedPairs(rig, stripeBelowTheBoard(rig), 2, 2.0);
     const EstimateResult result = runAfterAnotherStep(sceneStream({{board, 1.0}, {table, 2.0}}), rig, 10.0);
-    ASSERT_TRUE(result.calibration) << result.problem;
-    EXPECT_LT(result.rmsPx, 0.5);
+    ASSERT_TRUE(result.ok()) << result.failure().message;
+    EXPECT_LT(result->rmsPx, 0.5);
 
     const EstimateResult waited = runAfterAnotherStep(sceneStream({{board, 3.0}}), rig, 2.0);
-    EXPECT_EQ(waited.problem, "the scene did not change and hold still again within 2 s");
+    ASSERT_FALSE(waited.ok());
+    EXPECT_EQ(waited.failure().message, "the scene did not change and hold still again within 2 s");
 }
 
 }  // namespace

@@ -192,14 +192,14 @@ TEST(TableSetupScenario, TheStripeIsFoundWhereTheCardLies) {
         const CalibrationStage stage(simulator.calibration(), calibrationChessboard());
         EXPECT_GT(stage.clearance(card).least(), 5.0);
 
-        const core::TableRectangleDetection stripe = core::findTableRectangle(pair.texture, {});
-        ASSERT_TRUE(stripe.success) << stripe.message;
-        const double error = worstCornerError(stripe.corners, stripeInCamera(simulator.calibration(), card));
+        const core::Result<core::TableRectangleDetection> stripe = core::findTableRectangle(pair.texture, {});
+        ASSERT_TRUE(stripe.ok()) << stripe.failure().message;
+        const double error = worstCornerError(stripe->corners, stripeInCamera(simulator.calibration(), card));
         RecordProperty("stripe_corner_error_px_seed" + std::to_string(seed), std::to_string(error));
         EXPECT_LT(error, 0.3);
-        const core::ChessboardDetection chessboard =
+        const core::Result<core::ChessboardDetection> chessboard =
             core::detectProjectedChessboard(pair.texture, calibrationChessboard(), p.projectorSize);
-        EXPECT_TRUE(chessboard.success) << chessboard.message;
+        EXPECT_TRUE(chessboard.ok()) << chessboard.failure().message;
     }
 }
 
@@ -326,34 +326,34 @@ TEST(PairCalibrationScenario, ChessboardAndStripeOnEveryBoardPoseAgreeWithTheGeo
         ASSERT_TRUE(pair.truth.props.card);
         ASSERT_EQ(pair.truth.props.board.has_value(), k > 0);
 
-        const core::ChessboardDetection chessboard =
+        const core::Result<core::ChessboardDetection> chessboard =
             core::detectProjectedChessboard(pair.texture, calibrationChessboard(), p.projectorSize);
-        ASSERT_TRUE(chessboard.success) << "pose " << k << ": " << chessboard.message;
+        ASSERT_TRUE(chessboard.ok()) << "pose " << k << ": " << chessboard.failure().message;
         // Each corner: the projector's ray through it meets the surface, and the camera sees that point.
         const Eigen::Isometry3d surface =
             k > 0 ? pair.truth.props.board->faceToTable : Eigen::Isometry3d::Identity();
         const Eigen::Vector3d normal = surface.linear().col(2), origin = surface.translation();
         double sum2 = 0.0, worst = 0.0;
-        for (size_t i = 0; i < chessboard.projectorCorners.size(); ++i) {
+        for (size_t i = 0; i < chessboard->projectorCorners.size(); ++i) {
             const Eigen::Vector3d direction =
                 projectorToTable.linear() *
-                (calibration.projectorMatrix.inverse() * chessboard.projectorCorners[i].homogeneous());
+                (calibration.projectorMatrix.inverse() * chessboard->projectorCorners[i].homogeneous());
             const Eigen::Vector3d centre = projectorToTable.translation();
             const Eigen::Vector3d point =
                 centre + direction * (normal.dot(origin - centre) / normal.dot(direction));
-            const double error = (project(calibration, point) - chessboard.cameraCorners[i]).norm();
+            const double error = (project(calibration, point) - chessboard->cameraCorners[i]).norm();
             sum2 += error * error;
             worst = std::max(worst, error);
         }
-        const double rms = std::sqrt(sum2 / chessboard.cameraCorners.size());
+        const double rms = std::sqrt(sum2 / chessboard->cameraCorners.size());
         RecordProperty("chessboard_rms_px_pose" + std::to_string(k), std::to_string(rms));
         EXPECT_LT(rms, 0.15) << "pose " << k;
         EXPECT_LT(worst, 0.4) << "pose " << k;
 
-        const core::TableRectangleDetection stripe = core::findTableRectangle(pair.texture, {});
-        ASSERT_TRUE(stripe.success) << "pose " << k << ": " << stripe.message;
+        const core::Result<core::TableRectangleDetection> stripe = core::findTableRectangle(pair.texture, {});
+        ASSERT_TRUE(stripe.ok()) << "pose " << k << ": " << stripe.failure().message;
         const double error =
-            worstCornerError(stripe.corners, stripeInCamera(calibration, *pair.truth.props.card));
+            worstCornerError(stripe->corners, stripeInCamera(calibration, *pair.truth.props.card));
         RecordProperty("stripe_corner_error_px_pose" + std::to_string(k), std::to_string(error));
         EXPECT_LT(error, 0.3) << "pose " << k;
     }
