@@ -49,10 +49,10 @@ struct FingertipMatch {
     double errorPx = 0.0;
 };
 
-// One-to-one matches of detected fingertips (raw camera pixels) to truth points, the closest pairs first. A
-// detection can match a truth point no further than one finger width away: the end of a finger's silhouette
-// lies up to about a pad's length from the point under the pad, and the next finger is a finger width away
-// or more, so a wider radius would credit a neighbour's tip.
+// One-to-one matches of detected fingertips (their pads, raw camera pixels) to truth points, the closest
+// pairs first. A detection can match a truth point no further than one finger width away: the next finger is
+// a finger width away or more, so a wider radius would credit a neighbour's tip, and a pad placed anywhere on
+// the right fingertip, even at the silhouette's end a third of a width ahead, is within it.
 std::vector<FingertipMatch> matchFingertips(const std::vector<TruthPoint>& truth,
                                             const std::vector<Eigen::Vector2d>& detections);
 

@@ -43,8 +43,13 @@ void RecordingPairs::complete(const core::FramePair& pair, std::size_t position,
     auto first = std::lower_bound(
         truth.begin(), truth.end(), index,
         [](const core::FingerTruth& finger, std::uint64_t i) { return finger.frameIndex < i; });
-    for (auto finger = first; finger != truth.end() && finger->frameIndex == index; ++finger)
-        out.fingers.push_back(truthToCamera_(*finger));
+    const cv::Rect frame(cv::Point(0, 0), out.truthMask.size());
+    for (auto finger = first; finger != truth.end() && finger->frameIndex == index; ++finger) {
+        // A finger over the display but high enough to be out of the camera's view cannot be found.
+        const TruthPoint point = truthToCamera_(*finger);
+        if (frame.contains(cv::Point2d(point.camera.x(), point.camera.y())))
+            out.fingers.push_back(point);
+    }
 }
 
 }  // namespace everytouch::eval

@@ -20,7 +20,7 @@ struct PairWithTruth {
     cv::Mat texture;                  // T (core/code_image.h)
     cv::Mat subtraction;              // S
     cv::Mat truthMask;                // masks/ of the newer frame, CV_8UC1, 255 = hand
-    std::vector<TruthPoint> fingers;  // truth.csv of the newer frame, in the camera
+    std::vector<TruthPoint> fingers;  // truth.csv of the newer frame, in the camera's view
 };
 
 // The pairs of a recording as the daemon forms them (core::FramePairer: each frame with the previous one

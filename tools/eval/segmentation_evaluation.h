@@ -15,8 +15,9 @@
 
 namespace everytouch::eval {
 
-// Fingertips found on a hand mask (CV_8UC1, 255 = hand), raw camera pixels.
-using FingertipFinder = std::function<void(const cv::Mat& mask, std::vector<Eigen::Vector2d>& tips)>;
+// The fingertips found on a hand mask (CV_8UC1, 255 = hand): their pads, where a touch is reported, raw
+// camera pixels.
+using FingertipFinder = std::function<void(const cv::Mat& mask, std::vector<Eigen::Vector2d>& pads)>;
 
 struct MethodResult {
     std::string name;
