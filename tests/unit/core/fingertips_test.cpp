@@ -1,10 +1,9 @@
 #include "core/fingertips.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
-#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -14,25 +13,7 @@
 #include "core/geometry.h"
 #include "sim/rig_geometry.h"
 #include "sim/simulator.h"
-
-// Counts the heap allocations of this test program, so that a test can tell that a call made none.
-namespace {
-std::atomic<long> allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-    ++allocations;
-    if (void* p = std::malloc(size == 0 ? 1 : size))
-        return p;
-    throw std::bad_alloc();
-}
-// Kept out of line: inlined, free() would meet a pointer the compiler takes for one from operator new.
-[[gnu::noinline]] void operator delete(void* p) noexcept {
-    std::free(p);
-}
-[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept {
-    std::free(p);
-}
+#include "support/allocation_counter.h"
 
 namespace everytouch::core {
 namespace {
@@ -244,13 +225,13 @@ TEST(Fingertips, AllocateNothingOnceWarm) {
     cv::Mat none = cv::Mat::zeros(488, 648, CV_8UC1);
     FingertipScratch scratch;
     Fingertips found;
-    const long cold = allocations;
+    const std::uint64_t cold = test::allocationCount();
     findFingertips(twoHands, drawnOptions(), scratch, found);
-    EXPECT_GT(allocations - cold, 0) << "the first frame sizes the buffers";
-    const long before = allocations;
+    EXPECT_GT(test::allocationCount() - cold, 0u) << "the first frame sizes the buffers";
+    const std::uint64_t before = test::allocationCount();
     for (cv::Mat* mask : {&oneHand, &none, &twoHands, &oneHand})
         findFingertips(*mask, drawnOptions(), scratch, found);
-    EXPECT_EQ(allocations - before, 0);
+    EXPECT_EQ(test::allocationCount() - before, 0u);
     EXPECT_EQ(found.size(), 2u);
 }
 

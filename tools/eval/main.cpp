@@ -1,0 +1,182 @@
+// everytouch-eval: scores the pipeline's stages on a recording against its ground truth.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/fingertips.h"
+#include "eval/contact_sheet.h"
+#include "eval/fingertip_scoring.h"
+#include "eval/segmentation_evaluation.h"
+#include "eval/segmentation_methods.h"
+#include "eval/segmentation_report.h"
+#include "io/input_error.h"
+#include "io/recording.h"
+#include "version.h"
+
+namespace {
+
+using namespace everytouch;
+
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+
+struct SegmentationArguments {
+    std::string recording;
+    std::string json;
+    std::string png;
+    std::vector<std::string> methodNames;  // empty: all
+    // The width of a finger, mm: an adult index finger is about 16 mm across at its last joint (the
+    // simulated hand's finger bones are 13-18.5 mm wide). It scales the fingertip finder and the match
+    // radius.
+    double fingerWidthMm = 16.0;
+    eval::MethodOptions methods;
+    eval::ContactSheetOptions sheet;
+};
+
+CLI::App* addSegmentationCommand(CLI::App& app, SegmentationArguments& arguments) {
+    CLI::App* command = app.add_subcommand(
+        "segmentation",
+        "Score hand segmentation on every pair of a recording with masks: precision, recall and F_beta per "
+        "method, fingertip detection rate and error against truth.csv");
+    command->add_option("REC", arguments.recording, "Recording directory (rig.yml, frames, masks/)")
+        ->required();
+    command->add_option("--json", arguments.json, "Also write the results as JSON to FILE");
+    command->add_option("--png", arguments.png, "Draw a contact sheet (texture, truth, each method's mask)");
+    command
+        ->add_option("--methods", arguments.methodNames,
+                     "Score only these methods (ours, paper, SCM, BkSub), comma-separated")
+        ->delimiter(',');
+    command->add_option("--rows", arguments.sheet.rows, "Pairs on the contact sheet")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    command
+        ->add_option("--finger-width-mm", arguments.fingerWidthMm,
+                     "Width of a finger: the fingertip finder's scale and the match radius")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    command
+        ->add_option("--background-pairs", arguments.methods.background.samples,
+                     "Pairs sharing no frame at the recording's start whose median is BkSub's background")
+        ->capture_default_str()
+        ->check(CLI::Range(3, 1000));
+    command->footer(
+        "Methods:\n"
+        "  ours   the pipeline's segmentation by the embedded code (core::HandSegmenter).\n"
+        "  paper  the paper's method as published: HC saliency, mean shift, confidence fusion, closing.\n"
+        "  SCM    the statistical skin-colour model of Jones & Rehg (IJCV 2002): their published RGB "
+        "Gaussian\n"
+        "         mixtures (16 skin, 16 non-skin kernels), maximum-likelihood decision, on the texture T.\n"
+        "  BkSub  background subtraction. The paper's predecessor predicts the empty table from the "
+        "projected\n"
+        "         content through its calibration; a recording does not carry the content, so here the\n"
+        "         background is the per-pixel median of the textures of the first pairs (a recording should\n"
+        "         start with the table empty and the content still). A pixel is hand where a channel "
+        "differs\n"
+        "         by more than the threshold at which camera noise, measured in the same pairs, marks one\n"
+        "         pixel per frame.\n"
+        "Scores: pixel counts summed over all pairs (micro average) and per-pair means, over the whole "
+        "frame\n"
+        "(as the paper) and within the display; F_beta with beta^2 = 0.3 (paper eq. 23). Fingertips found\n"
+        "on each mask are matched one to one to truth.csv's fingers, mapped into the camera through\n"
+        "rig.yml's calibration, within one finger width.\n"
+        "Only rig.yml (calibration, pattern, delta), frames, masks/ and truth.csv are read. See\n"
+        "docs/evaluation.md.");
+    return command;
+}
+
+int runSegmentation(const SegmentationArguments& arguments) {
+    const io::Recording recording = io::Recording::open(arguments.recording);
+    if (!recording.hasMasks())
+        throw io::InputError(
+            arguments.recording, "masks/",
+            "missing; segmentation is scored against the truth masks masks/NNNNNN.png, which "
+            "everytouchd --record writes on the simulated rig");
+    const eval::TruthToCamera truthToCamera(recording.rig().calibration, arguments.fingerWidthMm);
+    std::vector<eval::SegmentationMethod> methods = eval::segmentationMethods(recording, arguments.methods);
+    if (!arguments.methodNames.empty()) {
+        std::vector<eval::SegmentationMethod> chosen;
+        for (const std::string& name : arguments.methodNames) {
+            auto found =
+                std::find_if(methods.begin(), methods.end(),
+                             [&](const eval::SegmentationMethod& method) { return method.name == name; });
+            if (found == methods.end())
+                throw io::InputError("--methods " + name, "", "not a method (ours, paper, SCM, BkSub)");
+            chosen.push_back(*found);
+        }
+        methods = chosen;
+    }
+
+    // The finder as the pipeline sets it up for this rig; its pads are what a touch is reported at.
+    const core::FingertipOptions fingertipOptions =
+        core::rigFingertipOptions(recording.rig().calibration, arguments.fingerWidthMm);
+    if (const auto problem = fingertipOptions.validate())
+        throw io::InputError(arguments.recording + "/rig.yml", "",
+                             "no fingertip finder for this rig: " + *problem);
+    core::FingertipScratch scratch;
+    core::Fingertips found;
+    const eval::FingertipFinder findFingertips = [&](const cv::Mat& mask,
+                                                     std::vector<Eigen::Vector2d>& pads) {
+        core::findFingertips(mask, fingertipOptions, scratch, found);
+        pads.clear();
+        for (const core::Fingertip& fingertip : found)
+            pads.push_back(fingertip.pad);
+    };
+    const eval::SegmentationReport report = eval::evaluateSegmentation(
+        recording, arguments.recording, methods, findFingertips, truthToCamera, arguments.fingerWidthMm);
+    std::fputs(eval::segmentationTable(report).c_str(), stdout);
+
+    if (!arguments.json.empty()) {
+        std::ofstream out(arguments.json);
+        out << eval::segmentationJson(report).dump(2) << '\n';
+        if (!out)
+            throw std::runtime_error(arguments.json + ": cannot be written");
+    }
+    if (!arguments.png.empty()) {
+        std::vector<std::size_t> positions = report.handPositions;
+        if (positions.empty())
+            for (std::size_t position = 1; position < recording.frames().size(); ++position)
+                positions.push_back(position);
+        const cv::Mat sheet = eval::renderContactSheet(recording, positions, methods, findFingertips,
+                                                       truthToCamera, arguments.sheet);
+        if (!cv::imwrite(arguments.png, sheet))
+            throw std::runtime_error(arguments.png + ": cannot be written");
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"everytouch-eval - scores everytouch's stages on recordings against their ground truth"};
+    app.set_version_flag("--version", std::string("everytouch-eval ") + kVersion);
+    app.require_subcommand(1);
+    app.footer("Exit status: 0 success, 1 failure, 2 bad input (option, recording, missing ground truth).");
+    SegmentationArguments segmentation;
+    CLI::App* segmentationCommand = addSegmentationCommand(app, segmentation);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        const int status = app.exit(error);
+        return status == 0 ? 0 : kExitBadInput;
+    }
+    cv::setNumThreads(1);
+    try {
+        if (*segmentationCommand)
+            return runSegmentation(segmentation);
+    } catch (const io::InputError& error) {
+        std::fprintf(stderr, "everytouch-eval: %s\n", error.what());
+        return kExitBadInput;
+    } catch (const std::exception& error) {
+        std::fprintf(stderr, "everytouch-eval: %s\n", error.what());
+        return kExitFailure;
+    }
+    return kExitFailure;
+}
