@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
     std::filesystem::path file;
     CLI::App* snapshotCommand = app.add_subcommand(
         "snapshot", "Save what the camera sees as a PNG (needs root or the everytouch group)");
-    snapshotCommand->add_option("WHAT", what, "camera, texture, subtraction or overlay")->required();
+    snapshotCommand->add_option("WHAT", what, "camera, texture, subtraction, mask or overlay")->required();
     snapshotCommand->add_option("FILE", file, "The PNG file to write")->required();
 
     try {

@@ -73,7 +73,9 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
         return;
     segmenter_.setRig(calibration, settings.pattern);
     height_.setRig(calibration, settings.pattern);
-    options_.fingertips.fingerWidthPx = options_.fingerWidthMm * segmenter_.pixelsPerMm();
+    const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
+    options_.fingertips.fingerWidthPx = rig.fingerWidthPx;
+    options_.fingertips.padDrop = rig.padDrop;
     const cv::Size2d displayMm = calibration.displaySizeMm();
     displayPixelsPerMm_ = calibration.displaySize.width / displayMm.width;
     rigCalibration_ = calibration;
@@ -143,8 +145,8 @@ void TouchPipeline::measureFingertips(const PipelineSettings& settings) {
         if (!observation.visible.valid)
             continue;  // the code on it is not seen well enough: no height, no contact this frame
         observation.padHeightMm = std::max(0.0, observation.visible.heightMm - options_.visibleAbovePadMm);
-        // The contact point lies below the fingertip: its end seen through the plane of the pad's height.
-        const Eigen::Vector2d undistorted = camera.undistortPixel(tip.tip);
+        // The contact point: the pad, seen through the plane of its height.
+        const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
             applyHomography(calibration.cameraToDisplayHomography(observation.padHeightMm), undistorted);
         FingerObservation& finger = observations_.emplace_back();

@@ -28,7 +28,8 @@ struct PipelineSettings {
 // How the pipeline finds contacts. Each stage's options document themselves.
 struct DetectionOptions {
     SegmentationOptions segmentation;
-    FingertipOptions fingertips;  // fingerWidthPx is set from the calibration
+    FingertipOptions
+        fingertips;  // the scale and the pad's drop come from the calibration (rigFingertipOptions)
     HeightOptions height;
     TrackerOptions tracker;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.

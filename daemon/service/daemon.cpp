@@ -266,6 +266,8 @@ DaemonState Daemon::state() const {
         return DaemonState::Failed;
     if (calibration_)
         return DaemonState::Calibrating;
+    if (calibrated() && loop_ && loop_->statistics().pairs == 0)
+        return DaemonState::Starting;  // until detection has seen its first pair
     if (!calibrated() || !loop_ || !loop_->detecting())
         return DaemonState::Degraded;
     return DaemonState::Running;
