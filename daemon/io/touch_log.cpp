@@ -101,6 +101,7 @@ std::vector<TouchLogEntry> readTouchLog(const std::filesystem::path& path) {
         if (line.is_discarded() || !line.is_object())
             throw InputError(input, where, "not a JSON object");
         TouchLogEntry entry;
+        entry.line = number;
         entry.index = requireField<std::uint64_t>(line, "index", input, where);
         const auto time = line.find("t_us");
         if (time == line.end() || !time->is_number_integer())
