@@ -123,8 +123,9 @@ std::vector<TouchLogEntry> readTouchLog(const std::filesystem::path& path) {
                 contact.palm = palm->is_boolean() && palm->get<bool>();
             entry.contacts.push_back(contact);
         }
-        if (!entries.empty() && entry.index <= entries.back().index)
-            throw InputError(input, where, "index: must increase from line to line");
+        // The release of every contact when the stream ends carries the last frame's index again.
+        if (!entries.empty() && entry.index < entries.back().index)
+            throw InputError(input, where, "index: must not decrease from line to line");
         entries.push_back(std::move(entry));
     }
     return entries;
