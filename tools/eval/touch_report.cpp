@@ -24,8 +24,8 @@ std::string fixed(const std::optional<double>& value, int decimals) {
 
 std::string line(const char* label, const std::string& value, const std::string& note) {
     char text[256];
-    std::snprintf(text, sizeof text, "%-34s %10s  %s\n", label, value.c_str(), note.c_str());
-    return text;
+    std::snprintf(text, sizeof text, "%-34s %10s", label, value.c_str());
+    return std::string(text) + (note.empty() ? "" : "  " + note) + "\n";
 }
 
 }  // namespace
