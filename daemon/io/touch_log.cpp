@@ -101,6 +101,7 @@ std::vector<TouchLogEntry> readTouchLog(const std::filesystem::path& path) {
         if (line.is_discarded() || !line.is_object())
             throw InputError(input, where, "not a JSON object");
         TouchLogEntry entry;
+        entry.line = number;
         entry.index = requireField<std::uint64_t>(line, "index", input, where);
         const auto time = line.find("t_us");
         if (time == line.end() || !time->is_number_integer())
@@ -122,8 +123,9 @@ std::vector<TouchLogEntry> readTouchLog(const std::filesystem::path& path) {
                 contact.palm = palm->is_boolean() && palm->get<bool>();
             entry.contacts.push_back(contact);
         }
-        if (!entries.empty() && entry.index <= entries.back().index)
-            throw InputError(input, where, "index: must increase from line to line");
+        // The release of every contact when the stream ends carries the last frame's index again.
+        if (!entries.empty() && entry.index < entries.back().index)
+            throw InputError(input, where, "index: must not decrease from line to line");
         entries.push_back(std::move(entry));
     }
     return entries;

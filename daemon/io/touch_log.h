@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@ struct TouchLogEntry {
     std::uint64_t index = 0;
     std::int64_t timestampUs = 0;
     core::Contacts contacts;
+    std::size_t line = 0;  // where readTouchLog found it, 1-based: messages about the entry name it
 };
 
 // Writes the JSON Lines touch log: one object per frame in which anything changed. "-" writes to stdout.

@@ -1,4 +1,6 @@
 // Runs the real everytouch-eval on recordings the real everytouchd makes of the simulated rig.
+#include <fstream>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -152,6 +154,104 @@ TEST(EverytouchEval, ARecordingWithoutAHandIsScoredNotRefused) {
     }
 }
 
+class EvaluateTouches : public ::testing::Test {
+protected:
+    // Two seconds of the grid35 session: the hand comes in after 0.6 s and taps the first circle.
+    static void SetUpTestSuite() {
+        directory_ = new test::TempDir;
+        const test::ProcessResult result =
+            test::runProcess({EVERYTOUCHD_PATH, "--rig", "sim:grid35", "--fast", "--frames", "240",
+                              "--record", recording().string()});
+        ASSERT_EQ(result.exitCode, 0) << result.err;
+    }
+    static void TearDownTestSuite() {
+        delete directory_;
+        directory_ = nullptr;
+    }
+    static std::filesystem::path recording() { return *directory_ / "grid35"; }
+    static std::filesystem::path scratch(const std::string& name) { return *directory_ / name; }
+
+    // The table and the JSON of one run; fails the test unless it succeeds.
+    static nlohmann::json score(const std::vector<std::string>& arguments,
+                                const std::filesystem::path& json) {
+        std::vector<std::string> command{EVERYTOUCH_EVAL_PATH, "touches", recording().string()};
+        command.insert(command.end(), arguments.begin(), arguments.end());
+        command.insert(command.end(), {"--json", json.string()});
+        const test::ProcessResult result = test::runProcess(command);
+        EXPECT_EQ(result.exitCode, 0) << result.err;
+        for (const char* row : {"240 frames", "FRR", "FAR", "epsilon at touch-down", "latency", "id swaps",
+                                "hover height error", "10-20 mm"})
+            EXPECT_THAT(result.out, HasSubstr(row));
+        return nlohmann::json::parse(test::fileContents(json));
+    }
+
+    static test::TempDir* directory_;
+};
+
+test::TempDir* EvaluateTouches::directory_ = nullptr;
+
+TEST_F(EvaluateTouches, ScoresThePipelineAndItsTouchLogAlike) {
+    const std::filesystem::path plot = scratch("touches.png");
+    const nlohmann::json direct = score({"--png", plot.string()}, scratch("direct.json"));
+    EXPECT_EQ(direct["frames"], 240);
+    EXPECT_TRUE(direct["log"].is_null());
+    EXPECT_DOUBLE_EQ(direct["match_radius_mm"].get<double>(), 8.0);
+    EXPECT_GT(direct["match_radius_px"].get<double>(), 1.0);
+    ASSERT_GE(direct["trials"].get<int>(), 1);
+    expectFraction(direct["frr"], "FRR");
+    EXPECT_GE(direct["far"].get<double>(), 0.0);
+    EXPECT_EQ(direct["per_trial"].size(), direct["trials"].get<std::size_t>());
+    for (const char* field : {"epsilon_touch_down_px", "epsilon_touching_px", "latency_frames",
+                              "hover_error_mm", "drag_deviation_px"})
+        EXPECT_TRUE(direct[field].contains("mean") && direct[field].contains("count")) << field;
+    EXPECT_EQ(direct["hover_error_bands"].size(), 4u);
+    EXPECT_GT(direct["hover_error_mm"]["count"].get<int>(), 0);
+    const cv::Mat picture = cv::imread(plot.string());
+    ASSERT_FALSE(picture.empty());
+
+    // The daemon replaying the recording logs what the evaluator found running the pipeline itself.
+    const std::filesystem::path log = scratch("touches.jsonl");
+    const test::ProcessResult replay = test::runProcess(
+        {EVERYTOUCHD_PATH, "--rig", "replay:" + recording().string(), "--fast", "--log", log.string()});
+    ASSERT_EQ(replay.exitCode, 0) << replay.err;
+    const nlohmann::json logged = score({log.string()}, scratch("logged.json"));
+    EXPECT_EQ(logged["log"], log.string());
+    EXPECT_EQ(logged["trials"], direct["trials"]);
+    EXPECT_EQ(logged["touch_downs"], direct["touch_downs"]);
+    EXPECT_EQ(logged["rejected"], direct["rejected"]);
+}
+
+TEST_F(EvaluateTouches, RefusesALogOfAnotherRecordingNamingTheLine) {
+    const std::filesystem::path log = scratch("foreign.jsonl");
+    {
+        std::ofstream out(log);
+        out << R"({"index": 3, "t_us": 25000, "contacts": []})" << '\n'
+            << R"({"index": 99999, "t_us": 900000, "contacts": []})" << '\n';
+    }
+    const test::ProcessResult result =
+        test::runProcess({EVERYTOUCH_EVAL_PATH, "touches", recording().string(), log.string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("line 2"));
+    EXPECT_THAT(result.err, HasSubstr("99999"));
+}
+
+TEST(EverytouchEval, TouchesRefusesARecordingWithoutTruth) {
+    test::TempDir directory;
+    const std::filesystem::path bare = directory / "bare";
+    io::RecordingWriter writer(bare, test::paperLikeRig(), false);
+    for (std::uint64_t i = 0; i < 4; ++i) {
+        core::Frame frame;
+        frame.index = i;
+        frame.polarity = i % 2 ? core::Polarity::Negative : core::Polarity::Positive;
+        frame.image = cv::Mat(cv::Size(648, 488), CV_8UC3, cv::Scalar(128, 128, 128));
+        writer.addFrame(frame);
+    }
+    writer.flush();
+    const test::ProcessResult result = test::runProcess({EVERYTOUCH_EVAL_PATH, "touches", bare.string()});
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_THAT(result.err, HasSubstr("truth.csv"));
+}
+
 TEST(EverytouchEval, HelpNamesTheSubcommandsAndTheBaselinesDeviation) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCH_EVAL_PATH, "segmentation", "--help"});
     EXPECT_EQ(result.exitCode, 0);
@@ -159,6 +259,7 @@ TEST(EverytouchEval, HelpNamesTheSubcommandsAndTheBaselinesDeviation) {
         EXPECT_THAT(result.out, HasSubstr(text));
     const test::ProcessResult top = test::runProcess({EVERYTOUCH_EVAL_PATH, "--help"});
     EXPECT_THAT(top.out, HasSubstr("segmentation"));
+    EXPECT_THAT(top.out, HasSubstr("touches"));
     EXPECT_THAT(top.out, HasSubstr("Exit status"));
 }
 

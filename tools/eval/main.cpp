@@ -13,12 +13,18 @@
 
 #include "core/fingertips.h"
 #include "eval/contact_sheet.h"
+#include "eval/detected_contacts.h"
 #include "eval/fingertip_scoring.h"
 #include "eval/segmentation_evaluation.h"
 #include "eval/segmentation_methods.h"
 #include "eval/segmentation_report.h"
+#include "eval/touch_plot.h"
+#include "eval/touch_report.h"
+#include "eval/touch_scoring.h"
+#include "eval/touch_trials.h"
 #include "io/input_error.h"
 #include "io/recording.h"
+#include "io/touch_log.h"
 #include "version.h"
 
 namespace {
@@ -152,6 +158,98 @@ int runSegmentation(const SegmentationArguments& arguments) {
     return 0;
 }
 
+struct TouchArguments {
+    std::string recording;
+    std::string log;  // empty: run the pipeline on the recording
+    std::string json;
+    std::string png;
+    // The match radius, mm: half a finger width (an adult index finger is about 16 mm across), the distance
+    // from a finger's contact point to the middle between it and a neighbour resting beside it.
+    double matchRadiusMm = 8.0;
+    // Where the pipeline reports a touch, mm: the daemon's default ([Touch] HeightMm=).
+    double touchHeightMm = 3.0;
+    // The paper's claim: no touch is reported with the finger 8 mm or more above the table.
+    double highHoverMm = 8.0;
+};
+
+CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
+    CLI::App* command = app.add_subcommand(
+        "touches",
+        "Score detected touches against truth.csv: FRR and FAR per tap trial, touch point error epsilon, "
+        "touch-down latency, drag deviation, id swaps, hover height error");
+    command->add_option("REC", arguments.recording, "Recording directory with truth.csv")->required();
+    command->add_option("LOG", arguments.log,
+                        "Touch log made from REC (everytouchd --rig replay:REC --log LOG); without it the "
+                        "pipeline runs on REC");
+    command->add_option("--json", arguments.json, "Also write the results as JSON to FILE");
+    command->add_option("--png", arguments.png,
+                        "Plot true (green) and detected (red) touch-down points over the display");
+    command
+        ->add_option("--match-radius-mm", arguments.matchRadiusMm,
+                     "How far a contact may lie from a true contact point and still be that finger")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    command
+        ->add_option("--touch-height-mm", arguments.touchHeightMm,
+                     "Touch height the pipeline runs with (without LOG)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    command
+        ->add_option("--high-hover-mm", arguments.highHoverMm,
+                     "Fingers at least this high must never be reported touching")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    command->footer(
+        "A trial is a maximal run of frames in which one finger's pad is on the table (truth height 0). In\n"
+        "every frame true fingers and detected contacts (palms left out) are matched one to one, nearest\n"
+        "first, within the match radius (converted to display pixels with rig.yml's calibration).\n"
+        "  FRR      trials in which no matching contact touches / trials\n"
+        "  FAR      touch-downs (a contact going to touch) with no true touching finger within the radius\n"
+        "           at that frame, per true trial; also given as a count\n"
+        "  epsilon  distance from the detected touch point to the true contact point (paper eq. 24) at the\n"
+        "           trial's reported touch-down, and over every frame both touch, display pixels\n"
+        "  latency  frames from the trial's first frame to the first frame a matching contact touches\n"
+        "  drag     distance of a touching contact to the true path, over trials moving beyond the radius\n"
+        "  id swaps changes of the matched contact's id while the finger stays touching\n"
+        "  hover    |height_mm - truth| of hovering fingers matched to a contact, also by band\n"
+        "See docs/evaluation.md.");
+    return command;
+}
+
+int runTouches(const TouchArguments& arguments) {
+    const io::Recording recording = io::Recording::open(arguments.recording);
+    if (!recording.hasTruth())
+        throw io::InputError(arguments.recording, "truth.csv",
+                             "missing; touches are scored against the fingers truth.csv lists, which "
+                             "everytouchd --record writes on the simulated rig");
+    eval::DetectedFrames detected;
+    if (arguments.log.empty())
+        detected = eval::contactsFromPipeline(recording, core::DetectionOptions{}, arguments.touchHeightMm);
+    else
+        detected = eval::contactsFromLog(recording, io::readTouchLog(arguments.log), arguments.log);
+
+    eval::TouchScoringOptions options;
+    options.matchRadiusPx = eval::matchRadiusPx(recording.rig().calibration, arguments.matchRadiusMm);
+    options.highHoverMm = arguments.highHoverMm;
+    if (const auto problem = options.validate())
+        throw io::InputError(arguments.recording + "/rig.yml", "", *problem);
+    const eval::TouchScore score = eval::scoreTouches(eval::truthFrames(recording), detected, options);
+    const eval::TouchSource source{arguments.recording, arguments.log, arguments.matchRadiusMm,
+                                   recording.rig().frameRate};
+    std::fputs(eval::touchTable(source, score).c_str(), stdout);
+
+    if (!arguments.json.empty()) {
+        std::ofstream out(arguments.json);
+        out << eval::touchJson(source, score).dump(2) << '\n';
+        if (!out)
+            throw std::runtime_error(arguments.json + ": cannot be written");
+    }
+    if (!arguments.png.empty() &&
+        !cv::imwrite(arguments.png, eval::plotTouchDowns(score, recording.rig().calibration.displaySize)))
+        throw std::runtime_error(arguments.png + ": cannot be written");
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -161,6 +259,8 @@ int main(int argc, char** argv) {
     app.footer("Exit status: 0 success, 1 failure, 2 bad input (option, recording, missing ground truth).");
     SegmentationArguments segmentation;
     CLI::App* segmentationCommand = addSegmentationCommand(app, segmentation);
+    TouchArguments touches;
+    CLI::App* touchCommand = addTouchCommand(app, touches);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
@@ -171,6 +271,8 @@ int main(int argc, char** argv) {
     try {
         if (*segmentationCommand)
             return runSegmentation(segmentation);
+        if (*touchCommand)
+            return runTouches(touches);
     } catch (const io::InputError& error) {
         std::fprintf(stderr, "everytouch-eval: %s\n", error.what());
         return kExitBadInput;
