@@ -88,9 +88,11 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     result_.timestampUs = pair.latest().timestampUs;
     computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
     result_.handMask.create(result_.texture.size(), CV_8UC1);
-    if (!settings.calibration || settings.pattern.empty()) {
+    if (!settings.detect || !settings.calibration || settings.pattern.empty()) {
         result_.detecting = false;
-        result_.idleReason = !settings.calibration ? "not calibrated" : "the projected code is not known";
+        result_.idleReason = !settings.detect        ? "the projector shows calibration images"
+                             : !settings.calibration ? "not calibrated"
+                                                     : "the projected code is not known";
         fill(result_.handMask, 0);
         reset();
         return result_;

@@ -23,6 +23,9 @@ struct PipelineSettings {
     std::optional<Calibration> calibration;  // nothing while uncalibrated: no contacts can be found
     cv::Mat pattern;             // the code projected: CV_8UC1 0/1, projector size; empty when unknown
     double touchHeightMm = 0.0;  // a finger pad at or below this height touches
+    // False while the projector shows something else than the content (a calibration's images): there is
+    // nothing to detect, and the calibration wants the frames at their full rate.
+    bool detect = true;
 };
 
 // How the pipeline finds contacts. Each stage's options document themselves.

@@ -266,15 +266,14 @@ DaemonState Daemon::state() const {
         return DaemonState::Failed;
     if (calibration_)
         return DaemonState::Calibrating;
-    if (calibrated() && loop_ && loop_->statistics().pairs == 0)
-        return DaemonState::Starting;  // until detection has seen its first pair
-    if (!calibrated() || !loop_ || !loop_->detecting())
+    // Detection runs on every pair once calibrated with the code known, unless a stage keeps failing.
+    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing())
         return DaemonState::Degraded;
     return DaemonState::Running;
 }
 
 core::PipelineSettings Daemon::pipelineSettings() const {
-    return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_};
+    return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_, calibration_ == nullptr};
 }
 
 LoopStatistics Daemon::statistics() const {
@@ -412,6 +411,7 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
         [this](const CalibrationOutcome& outcome) {
             inbox_.post([this, outcome] { finishCalibration(outcome); });
         });
+    applySettings();  // no detection while the projector shows calibration images
     refreshState();
 }
 
@@ -421,12 +421,12 @@ void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
     calibration_.reset();
     if (outcome.ok) {
         store_->activate(*outcome.calibration);
-        applySettings();
         ET_LOG(Notice) << outcome.message << "; SaveCalibration keeps it";
     } else {
         ET_LOG(Warning) << "calibration failed: " << outcome.message
                         << "; the previous calibration stays active";
     }
+    applySettings();  // detection again, with the new calibration if there is one
     if (bus_)
         bus_->calibrationFinished(outcome.ok, outcome.message, outcome.rmsPx);
     refreshState();

@@ -200,17 +200,19 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
             ++statistics_.pipelineFailures;
             idleReason_ = std::string("detection failed: ") + error.what();
         }
-        if (!failing_)
+        if (!failingNow_.exchange(true)) {
             ET_LOG(Error) << "detection failed on frame " << pair.latest().index << ": " << error.what()
                           << "; every contact is released until it works again";
-        failing_ = true;
+            notify_();
+        }
         tap_.offer(pair, nullptr);
         publish(pair.latest().index, pair.latest().timestampUs, core::Contacts{});
         return;
     }
-    if (failing_)
+    if (failingNow_.exchange(false)) {
         ET_LOG(Notice) << "detection works again from frame " << pair.latest().index;
-    failing_ = false;
+        notify_();
+    }
     recordPipelineTime(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
     const bool changed = detecting_ != result->detecting;
     if (changed || !result->detecting) {

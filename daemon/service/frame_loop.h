@@ -81,6 +81,8 @@ public:
     void setSettings(core::PipelineSettings settings);
     // Whether detection ran on the last pair (calibrated, the code known, no failure); why not, when not.
     bool detecting() const { return detecting_; }
+    // Whether a stage failed on the last pair.
+    bool failing() const { return failingNow_; }
     std::string idleReason() const;
     FrameTap& tap() { return tap_; }
 
@@ -106,7 +108,7 @@ private:
     std::atomic<bool> stopping_{false};
     std::atomic<bool> finished_{false};
     std::atomic<bool> detecting_{false};
-    bool failing_ = false;  // pipeline thread only: the last pair failed, so the failure was logged once
+    std::atomic<bool> failingNow_{false};  // the last pair failed; its failure has been logged once
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
     std::thread pipelineThread_;
