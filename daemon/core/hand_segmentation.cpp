@@ -89,8 +89,6 @@ std::optional<std::string> SegmentationOptions::validate() const {
         return "blockPx: must be at least 2 pixels";
     if (windowBlocks < 1 || windowBlocks % 2 == 0)
         return "windowBlocks: must be an odd number of blocks";
-    if (!(litFraction > 0.0 && litFraction < 1.0))
-        return "litFraction: must be in (0, 1)";
     if (!(cameraBlurPx >= 0.0) || !std::isfinite(cameraBlurPx))
         return "cameraBlurPx: must be a non-negative number of pixels";
     if (!(fingerWidthMm > 0.0) || !std::isfinite(fingerWidthMm))
@@ -158,14 +156,11 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     values_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
-    judgedRegion_ = cv::Mat::zeros(calibration.cameraSize, CV_8UC1);
     for (int by = reach; by < blocks.height - reach; ++by)
         for (int bx = reach; bx < blocks.width - reach; ++bx)
-            if (cv::countNonZero(onDisplay(cv::Rect(bx - reach, by - reach, 2 * reach + 1, 2 * reach + 1))) ==
-                (2 * reach + 1) * (2 * reach + 1)) {
-                displayBlocks_.at<uchar>(by, bx) = 1;
-                judgedRegion_(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx)).setTo(255);
-            }
+            displayBlocks_.at<uchar>(by, bx) =
+                cv::countNonZero(onDisplay(cv::Rect(bx - reach, by - reach, 2 * reach + 1, 2 * reach + 1))) ==
+                (2 * reach + 1) * (2 * reach + 1);
 
     const Eigen::Matrix3d cameraToTable = calibration.tableToCameraHomography(0.0).inverse();
     const Eigen::Vector2d centre(calibration.cameraSize.width / 2.0, calibration.cameraSize.height / 2.0);

@@ -38,9 +38,6 @@ struct SegmentationOptions {
     // camera pixel sees about a projector pixel, enough to tell the table's code from another.
     int blockPx = 4;
     int windowBlocks = 3;
-    // A surface lit by the projector shows the code with an amplitude proportional to its albedo; below this
-    // fraction of the table's amplitude it is in a shadow or under black content, and the code says nothing.
-    double litFraction = 0.25;
     // The camera's own blur (Gaussian sigma, camera pixels) on top of its pixels' footprint, for predicting
     // how it sees the table's code.
     double cameraBlurPx = 0.5;
@@ -77,14 +74,6 @@ public:
     // allocates nothing.
     void segment(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
-    // The region of the camera image where hands are judged: the display as the camera sees it, less the
-    // half window of code at its edge (a hand elsewhere is outside what can be touched, and outside the
-    // projection there is no code). CV_8UC1, 255 inside.
-    const cv::Mat& judgedRegion() const { return judgedRegion_; }
-    // What the code said about each block in the last frame (Code method): 0 off the display, 1 the table's
-    // code, 2 too faint to tell, 3 lit but not the table's code, 4 such a block in a region large enough for
-    // a hand. CV_8UC1, block grid of blockPx.
-    const cv::Mat& blockClasses() const { return blockClass_; }
     // Camera pixels per millimetre on the table near the image centre (from the calibration).
     double pixelsPerMm() const { return pixelsPerMm_; }
 
@@ -101,7 +90,6 @@ private:
 
     SegmentationOptions options_;
     TableCode tableCode_;
-    cv::Mat judgedRegion_;
     cv::Rect displayBox_;    // the display's bounding box in the camera
     cv::Mat displayBlocks_;  // CV_8UC1, block grid: 1 where the whole window lies on the display
     double pixelsPerMm_ = 1.0;

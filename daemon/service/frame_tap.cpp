@@ -27,10 +27,10 @@ std::shared_ptr<const core::PipelineResult> deepCopy(const core::PipelineResult&
 
 }  // namespace
 
-FrameTap::Ticket FrameTap::request(std::size_t pairs, Done done) {
+FrameTap::Ticket FrameTap::request(std::size_t pairs, Done done, bool withDetection) {
     std::lock_guard lock(mutex_);
     const Ticket ticket = nextTicket_++;
-    pending_[ticket] = Pending{pairs, {}, std::move(done)};
+    pending_[ticket] = Pending{pairs, withDetection, {}, std::move(done)};
     wanted_ = true;
     return ticket;
 }
@@ -47,9 +47,13 @@ void FrameTap::offer(const core::FramePair& pair, const core::PipelineResult* de
     std::vector<Pending> filled;
     {
         std::lock_guard lock(mutex_);
-        const TappedPair copy{deepCopy(pair), detection ? deepCopy(*detection) : nullptr};
+        const core::FramePair pairCopy = deepCopy(pair);
+        std::shared_ptr<const core::PipelineResult> detectionCopy;
         for (auto it = pending_.begin(); it != pending_.end();) {
-            it->second.pairs.push_back(copy);
+            if (it->second.withDetection && detection && !detectionCopy)
+                detectionCopy = deepCopy(*detection);
+            it->second.pairs.push_back(
+                TappedPair{pairCopy, it->second.withDetection ? detectionCopy : nullptr});
             if (it->second.pairs.size() < it->second.wanted) {
                 ++it;
                 continue;
@@ -61,20 +65,6 @@ void FrameTap::offer(const core::FramePair& pair, const core::PipelineResult* de
     }
     for (Pending& request : filled)
         request.done(std::move(request.pairs));
-}
-
-std::shared_ptr<const core::PipelineResult> deepCopy(const core::PipelineResult& result) {
-    auto copy = std::make_shared<core::PipelineResult>();
-    copy->frameIndex = result.frameIndex;
-    copy->timestampUs = result.timestampUs;
-    copy->detecting = result.detecting;
-    copy->idleReason = result.idleReason;
-    copy->subtraction = result.subtraction.clone();
-    copy->texture = result.texture.clone();
-    copy->handMask = result.handMask.clone();
-    copy->fingertips = result.fingertips;
-    copy->contacts = result.contacts;
-    return copy;
 }
 
 }  // namespace everytouch::service

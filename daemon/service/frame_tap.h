@@ -30,8 +30,9 @@ public:
     // Runs on the pipeline thread with the requested pairs; must be quick (hand them over and return).
     using Done = std::function<void(std::vector<TappedPair>&&)>;
 
-    // Asks for the next `pairs` pairs; `done` receives them.
-    Ticket request(std::size_t pairs, Done done);
+    // Asks for the next `pairs` pairs; `done` receives them, with a copy of what detection made of each when
+    // `withDetection` (a snapshot shows it; a calibration step needs only the frames).
+    Ticket request(std::size_t pairs, Done done, bool withDetection = false);
     // Withdraws a request; `done` will not run unless it already has.
     void cancel(Ticket ticket);
 
@@ -41,6 +42,7 @@ public:
 private:
     struct Pending {
         std::size_t wanted = 0;
+        bool withDetection = false;
         std::vector<TappedPair> pairs;
         Done done;
     };

@@ -46,9 +46,12 @@ void SnapshotRequests::add(SnapshotKind kind, int fd, SnapshotReply reply) {
         throw BusError(SD_BUS_ERROR_FAILED, std::string("Cannot set a timeout: ") + std::strerror(-r));
     }
     request.timeout.reset(timeout);
-    request.ticket = loop_.tap().request(1, [this, id](std::vector<TappedPair>&& pairs) {
-        inbox_.post([this, id, tapped = std::move(pairs.front())] { complete(id, tapped); });
-    });
+    request.ticket = loop_.tap().request(
+        1,
+        [this, id](std::vector<TappedPair>&& pairs) {
+            inbox_.post([this, id, tapped = std::move(pairs.front())] { complete(id, tapped); });
+        },
+        true);
 }
 
 void SnapshotRequests::failAll(const char* errorName, const std::string& message) {

@@ -166,10 +166,13 @@ TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
     FrameLoop loop(source, pipeline_, {}, nullptr, options, {}, notifications_.callback());
     std::mutex mutex;
     std::vector<TappedPair> captured;
-    loop.tap().request(3, [&](std::vector<TappedPair>&& pairs) {
-        std::lock_guard lock(mutex);
-        captured = std::move(pairs);
-    });
+    loop.tap().request(
+        3,
+        [&](std::vector<TappedPair>&& pairs) {
+            std::lock_guard lock(mutex);
+            captured = std::move(pairs);
+        },
+        true);
     loop.start();
     ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
     std::lock_guard lock(mutex);
