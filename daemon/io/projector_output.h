@@ -2,16 +2,23 @@
 
 #include <string>
 
+#include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
 namespace everytouch::io {
 
-// What the projector shows instead of the desktop while a calibration needs it: a window, an external
-// program, or the simulated rig. Called from one thread at a time (the calibration's).
+// The projector's side of the rig: where the desktop is drawn on the panel, and what the projector shows
+// instead of it while a calibration needs it. A window, an external program, or the simulated rig. Called
+// from one thread at a time (the calibration's while a job runs, the main thread otherwise).
 class ProjectorOutput {
 public:
     virtual ~ProjectorOutput() = default;
+
+    // From now on the desktop, displaySize pixels, is drawn onto the panel through displayToProjector (H_dp,
+    // the keystone of the calibration that became active), so that it appears where the daemon maps touches.
+    // Throws std::invalid_argument for an empty size or a homography that is not finite and invertible.
+    virtual void setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) = 0;
 
     // Shows `projectorImage` (8-bit gray or BGR, size() pixels, one per projector pixel) until the next
     // show() or release(). Throws std::invalid_argument for an image of the wrong size or type.

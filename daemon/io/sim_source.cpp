@@ -44,8 +44,10 @@ std::optional<core::Frame> SimSource::next() {
         return std::nullopt;
     core::Frame frame;
     {
-        std::lock_guard lock(renderMutex_);
+        std::unique_lock lock(renderMutex_);
+        othersDone_.wait(lock, [this] { return othersWaiting_ == 0; });
         simulator_->render(index_, frame, truth_);
+        truthDisplaySize_ = simulator_->calibration().displaySize;
     }
     truthIndex_ = index_;
     if (paced_) {
@@ -57,14 +59,30 @@ std::optional<core::Frame> SimSource::next() {
     return frame;
 }
 
+std::unique_lock<std::mutex> SimSource::betweenFrames() const {
+    ++othersWaiting_;
+    std::unique_lock lock(renderMutex_);
+    --othersWaiting_;
+    othersDone_.notify_all();
+    return lock;
+}
+
 void SimSource::projectImage(const cv::Mat& projectorImage) {
-    std::lock_guard lock(renderMutex_);
+    const std::unique_lock lock = betweenFrames();
     simulator_->projectImage(projectorImage);
+}
+
+void SimSource::setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
+    const std::unique_lock lock = betweenFrames();
+    simulator_->setDisplayToProjector(displaySize, displayToProjector);
 }
 
 std::optional<RigDescription> SimSource::rig() const {
     RigDescription description;
-    description.calibration = simulator_->calibration();
+    {
+        const std::unique_lock lock = betweenFrames();
+        description.calibration = simulator_->calibration();
+    }
     description.delta = simulator_->parameters().delta;
     description.frameRate = simulator_->parameters().frameRate;
     description.pattern = simulator_->pattern().clone();
@@ -77,7 +95,7 @@ std::string SimSource::describe() const {
 
 std::optional<std::vector<core::FingerTruth>> SimSource::truth() const {
     std::vector<core::FingerTruth> fingers;
-    const cv::Size display = simulator_->calibration().displaySize;
+    const cv::Size display = truthDisplaySize_;
     for (const sim::FingertipTruth& tip : truth_.fingertips)
         if (tip.presented && tip.display.x >= 0.0 && tip.display.y >= 0.0 && tip.display.x < display.width &&
             tip.display.y < display.height)

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -37,16 +39,27 @@ public:
     // frames. Throws std::invalid_argument for another size or type.
     void projectImage(const cv::Mat& projectorImage);
     cv::Size projectorSize() const { return simulator_->calibration().projectorSize; }
+    // From the next frame on the desktop is drawn through the daemon's keystone (sim::Simulator::
+    // setDisplayToProjector); rig() and truth() then describe that display. Safe to call while another thread
+    // takes frames. Throws std::invalid_argument for an empty size or a homography that is not invertible.
+    void setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector);
 
 private:
     std::string spec_;
     std::unique_ptr<sim::Simulator> simulator_;
-    std::mutex renderMutex_;  // the camera thread renders while the calibration changes the projected image
+    // The renderer, for one thread at a time: the camera thread renders while the calibration changes the
+    // projected image and the daemon the keystone. Those go first (betweenFrames): a camera thread rendering
+    // back to back would otherwise take the mutex again before a waiting thread wakes up, for seconds.
+    std::unique_lock<std::mutex> betweenFrames() const;
+    mutable std::mutex renderMutex_;
+    mutable std::condition_variable othersDone_;
+    mutable std::atomic<int> othersWaiting_{0};
     bool paced_;
     std::uint64_t index_ = 0;
     std::chrono::steady_clock::time_point start_;
     sim::FrameTruth truth_;
     std::uint64_t truthIndex_ = 0;
+    cv::Size truthDisplaySize_;  // the display the last frame showed
 };
 
 }  // namespace everytouch::io

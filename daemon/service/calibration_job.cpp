@@ -63,6 +63,7 @@ CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
                                   const ProgressFunction& progress) {
     CalibrationOutcome outcome;
     std::optional<core::Calibration> current = start;
+    cv::Mat scene;
     const double stepShare = 1.0 / static_cast<double>(steps.size());
     for (std::size_t i = 0; i < steps.size(); ++i) {
         const CalibrationStep& step = steps[i];
@@ -76,7 +77,7 @@ CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
                                       progress(step.name, begun + stepShare * std::clamp(fraction, 0.0, 1.0),
                                                message);
                                   },
-                                  i > 0};
+                                  scene};
         EstimateResult result = step.run(context);
         if (!result.ok()) {
             outcome.message = "the " + step.name + " step failed: " + result.failure().message;
@@ -84,6 +85,7 @@ CalibrationOutcome runCalibration(const std::vector<CalibrationStep>& steps,
         }
         outcome.rmsPx = std::max(outcome.rmsPx, result->rmsPx);
         current = std::move(result->calibration);
+        scene = result->scene;
         progress(step.name, begun + stepShare, "Done with " + step.description);
     }
     outcome.ok = true;

@@ -32,6 +32,7 @@ struct CalibrationOptions {
 struct Estimate {
     core::Calibration calibration;
     double rmsPx = 0.0;
+    cv::Mat scene;  // the texture (8-bit gray) the step measured last: the scene as the step left it
 };
 // The estimate, or the reason the step could not find one.
 using EstimateResult = core::Result<Estimate>;
@@ -55,8 +56,9 @@ struct StepContext {
     ShowFunction show;
     // Progress within the step: fraction 0..1 of the step, a sentence for the user.
     std::function<void(double fraction, const std::string& message)> progress;
-    // Another step ran before this one in the same job: the scene still shows what that step needed.
-    bool followsAnotherStep = false;
+    // The scene the step before this one in the same job measured last (Estimate::scene): the camera may
+    // still see what that step needed. Empty when this step is the job's first.
+    cv::Mat previousScene;
 };
 
 using StepRunner = std::function<EstimateResult(const StepContext& context)>;

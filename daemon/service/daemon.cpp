@@ -103,11 +103,14 @@ int Daemon::run() {
     loadCalibration(rig);
 
     if (!options_.recordDir.empty()) {
-        if (!rig)
+        // The rig as it is now, its display drawn through the active calibration's keystone.
+        const std::optional<io::RigDescription> recorded = source_->rig();
+        if (!recorded)
             throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
         const bool withTruth = source_->truth().has_value();
         const bool withMasks = source_->truthMask().has_value();
-        recorder_ = std::make_unique<io::RecordingWriter>(options_.recordDir, *rig, withTruth, withMasks);
+        recorder_ =
+            std::make_unique<io::RecordingWriter>(options_.recordDir, *recorded, withTruth, withMasks);
     }
     if (const int r = startEventLoop(); r < 0)
         throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
@@ -146,6 +149,19 @@ void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
     else
         ET_LOG(Info) << "calibration from "
                      << (store_->keepsFile() ? store_->path().string() : std::string("the rig itself"));
+    if (store_->active())
+        drawDisplayThrough(*store_->active());
+}
+
+void Daemon::drawDisplayThrough(const core::Calibration& calibration) {
+    if (!projector_)
+        return;
+    try {
+        projector_->setDisplayToProjector(calibration.displaySize, calibration.displayToProjector);
+    } catch (const std::exception& error) {
+        ET_LOG(Error) << projector_->describe() << ": " << error.what()
+                      << "; the desktop stays where it was drawn";
+    }
 }
 
 std::vector<io::TouchSink*> Daemon::openOutputs() {
@@ -421,6 +437,7 @@ void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
     calibration_.reset();
     if (outcome.ok) {
         store_->activate(*outcome.calibration);
+        drawDisplayThrough(*outcome.calibration);
         ET_LOG(Notice) << outcome.message << "; SaveCalibration keeps it";
     } else {
         ET_LOG(Warning) << "calibration failed: " << outcome.message

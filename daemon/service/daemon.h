@@ -83,6 +83,9 @@ public:
 
 private:
     void loadCalibration(const std::optional<io::RigDescription>& rig);
+    // Has the projector draw the desktop through the keystone of `calibration`, the one now active, as the
+    // touches are mapped through it. A recording shows what it was recorded showing.
+    void drawDisplayThrough(const core::Calibration& calibration);
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
     void startFrameLoop(std::vector<io::TouchSink*> sinks);

@@ -123,6 +123,7 @@ EstimateResult calibrateProjectorCameraPairStep(const StepContext& context) {
     if (!result.ok())
         return core::Failure{"the table in pose 1: " + result.failure().message};
     result->rmsPx = pair->rmsPx.all;
+    result->scene = capture->lastViewTexture();
     return result;
 }
 

@@ -10,8 +10,8 @@ namespace everytouch::service {
 // taken by itself once the scene has held still, the board and the card are found, and the surface is tilted
 // away from every pose before (PoseCapture). The pair follows from all poses
 // (core::calibrateProjectorCameraPair), the table's pose from the first (core::setUpTable), and the display
-// is fitted into the lit area. Fails, saying what was missing, when no new pose comes within
-// options.viewTimeoutS of camera time.
+// is fitted into the lit area; the estimate's scene is the last pose's still texture. Fails, saying what was
+// missing, when no new pose comes within options.viewTimeoutS of camera time.
 EstimateResult calibrateProjectorCameraPairStep(const StepContext& context);
 
 }  // namespace everytouch::service

@@ -39,8 +39,11 @@ private:
 
 void drawDisplayOutline(const core::Calibration& calibration, int thickness, cv::Mat& image) {
     const DisplayToCamera toCamera(calibration, 0.0);
-    const double width = calibration.displaySize.width, height = calibration.displaySize.height;
-    const cv::Point2d corners[] = {{0, 0}, {width, 0}, {width, height}, {0, height}};
+    // The display's outer edges: pixel centres lie at whole coordinates (as warpPerspective draws the desktop
+    // onto the panel), so the first and last pixels reach half a pixel beyond them.
+    const double left = -0.5, top = -0.5;
+    const double right = calibration.displaySize.width - 0.5, bottom = calibration.displaySize.height - 0.5;
+    const cv::Point2d corners[] = {{left, top}, {right, top}, {right, bottom}, {left, bottom}};
     std::vector<cv::Point> outline;
     for (int edge = 0; edge < 4; ++edge) {
         const cv::Point2d from = corners[edge], to = corners[(edge + 1) % 4];

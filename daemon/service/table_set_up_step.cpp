@@ -32,12 +32,15 @@ cv::Mat averageTexture(const std::vector<core::FramePair>& pairs) {
     return average;
 }
 
-// Waits, pair by pair, until the scene has changed and then held still, and gives the still spell's average
-// texture (gray); fails when it does not within the options' view time-out.
-core::Result<cv::Mat> awaitNewStillScene(const StepContext& context) {
-    StillnessTracker stillness{PoseCaptureOptions()};
-    cv::Mat subtraction, texture, gray;
-    bool changed = false;
+// Waits, pair by pair, until the scene differs from `previous` (the scene the step before measured last,
+// 8-bit gray) and holds still, and gives the still spell's average texture (gray); fails when that does not
+// happen within the options' view time-out. The change is judged against that scene, not against the first
+// pair seen here: the board may have gone while the step before was still estimating.
+core::Result<cv::Mat> awaitNewStillScene(const StepContext& context, const cv::Mat& previous) {
+    const PoseCaptureOptions options;
+    StillnessTracker stillness{options};
+    cv::Mat subtraction, texture, gray, still;
+    bool looked = false;  // the current still spell was compared with `previous` already
     std::optional<std::int64_t> startUs;
     while (true) {
         const std::optional<std::vector<core::FramePair>> pairs = context.capture(1);
@@ -48,16 +51,17 @@ core::Result<cv::Mat> awaitNewStillScene(const StepContext& context) {
         if (const core::Status frame = core::grayFrame(texture, gray); !frame.ok())
             return core::Failure{"the camera frames: " + frame.failure().message};
         const std::int64_t nowUs = pair.latest().timestampUs;
-        const StillnessTracker::State state = stillness.offer(gray, nowUs);
-        if (!startUs) {
+        if (!startUs)
             startUs = nowUs;
-            continue;
-        }
-        changed = changed || state == StillnessTracker::State::Changed;
-        if (changed && state == StillnessTracker::State::Still) {
-            cv::Mat stillTexture;
-            stillness.average(stillTexture);
-            return stillTexture;
+        const StillnessTracker::State state = stillness.offer(gray, nowUs);
+        if (state == StillnessTracker::State::Changed)
+            looked = false;
+        if (state == StillnessTracker::State::Still && !looked) {
+            looked = true;
+            stillness.average(still);
+            if (still.size() != previous.size() ||
+                changedFraction(previous, still, options.changeSigmas) >= options.maxChangedFraction)
+                return still;
         }
         if ((nowUs - *startUs) * 1e-6 > context.options.viewTimeoutS)
             return core::Failure{"the scene did not change and hold still again within " +
@@ -101,11 +105,11 @@ EstimateResult setUpTableStep(const StepContext& context) {
     const std::string prompt =
         "The projector shows a chessboard: keep the table clear and lay the card flat in the white border "
         "below the board";
-    if (context.followsAnotherStep) {
-        // The scene still shows the previous step's last pose: wait until it has changed and holds still,
-        // and use what it showed while still.
+    if (!context.previousScene.empty()) {
+        // The scene may still show the previous step's last pose: wait until it differs from that and holds
+        // still, and use what it showed while still.
         context.progress(0.0, "Take the board away. " + prompt);
-        const core::Result<cv::Mat> texture = awaitNewStillScene(context);
+        const core::Result<cv::Mat> texture = awaitNewStillScene(context, context.previousScene);
         if (!texture.ok())
             return texture.failure();
         context.progress(0.5, "Estimating the table's pose from the chessboard and the card");
@@ -153,7 +157,13 @@ EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibra
     for (std::size_t corner = 0; corner < rawCorners.size(); ++corner)
         rawCorners[corner] = pair.camera.distortPixel(card->corners[corner]);
     table.rectangleCorners = rawCorners;
-    return calibrationOverTable(pair, table, cardRectangle(options).sizeMm, current.displaySize);
+    EstimateResult estimate =
+        calibrationOverTable(pair, table, cardRectangle(options).sizeMm, current.displaySize);
+    if (!estimate.ok())
+        return estimate;
+    if (const core::Status gray = core::grayFrame(texture, estimate->scene); !gray.ok())
+        return core::Failure{"the camera frames: " + gray.failure().message};
+    return estimate;
 }
 
 EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const core::PlaneView& table,
@@ -164,7 +174,7 @@ EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const
     if (!setUp.ok())
         return setUp.failure();
 
-    Estimate estimate{setUp->calibration, setUp->rmsPx.all};
+    Estimate estimate{setUp->calibration, setUp->rmsPx.all, cv::Mat()};
     estimate.calibration.displaySize = displaySize;
     const core::Result<core::KeystoneFit> keystone =
         core::fitDisplayToTable(estimate.calibration, displaySize);

@@ -36,7 +36,8 @@ EstimateResult setUpTableFromPairs(const std::vector<core::FramePair>& pairs,
                                    const std::optional<core::Calibration>& current,
                                    const CalibrationOptions& options);
 
-// The same on one texture (8-bit gray or BGR, the scene without the code) under the `current` pair.
+// The same on one texture (8-bit gray or BGR, the scene without the code) under the `current` pair; the
+// estimate's scene is that texture in gray.
 EstimateResult setUpTableFromTexture(const cv::Mat& texture, const core::Calibration& current,
                                      const CalibrationOptions& options);
 
@@ -49,7 +50,8 @@ EstimateResult calibrationOverTable(const core::ProjectorCameraPair& pair, const
 
 // The table step as the calibration job runs it: shows the board (tableSetUpChessboard) on white, captures
 // options.pairsPerStep pairs and sets the table up from them (setUpTableFromPairs). After another step of the
-// same job it first waits until the scene has changed and held still, and uses the still spell.
+// same job it instead waits until the scene differs from the one that step measured last
+// (StepContext::previousScene) and holds still, and uses the still spell.
 EstimateResult setUpTableStep(const StepContext& context);
 
 }  // namespace everytouch::service

@@ -85,7 +85,8 @@ private:
 
 // The one-time pair calibration as a user performs it: the card on the bare table, then a white board held in
 // five tilts, the card lying on it beside the projected chessboard, each pose held still and the board moved
-// between them. The session plays once and then holds the last pose.
+// between them; then the board is taken away and the card laid on the table again, as the table set-up that
+// follows asks ("calibrate full"). The session plays once and then holds that for good.
 class PairCalibrationScenario final : public Scenario {
 public:
     struct Pose {
@@ -97,17 +98,23 @@ public:
     };
     static constexpr double kHoldSeconds = 2.0;
     static constexpr double kMoveSeconds = 1.0;
+    // The least angle between the surfaces' normals, degrees: the dialogue asks for 10 as it measures them,
+    // and with the camera it guesses before any calibration it measures up to 3.3 short (see the poses).
+    static constexpr double kMinTiltDifferenceDeg = 14.0;
 
     // Throws std::invalid_argument when the rig leaves the card no room on the table or a tilted board.
     explicit PairCalibrationScenario(const ScenarioContext& context);
     SceneState at(double seconds) const override;
     double cycleSeconds() const override;
     std::vector<Props> stillProps() const override;
+    bool beginsWithTheProjector() const override { return true; }
     // The table pose first, then the board's five.
     const std::vector<Pose>& poses() const { return poses_; }
-    // Start and end of the still interval of pose k, seconds into the session (the last one lasts).
+    // Start and end of the still interval of pose k, seconds into the session.
     double holdStart(int pose) const;
     double holdEnd(int pose) const { return holdStart(pose) + kHoldSeconds; }
+    // When the board is gone and the card lies on the table again, for good, seconds into the session.
+    double tableAgainAt() const;
 
 private:
     std::vector<Pose> poses_;

@@ -241,6 +241,12 @@ void Renderer::setContent(const cv::Mat& displayContent) {
         showPanelImage(panelContent_);
 }
 
+void Renderer::setDisplay(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
+    calibration_.displaySize = displaySize;
+    calibration_.displayToProjector = displayToProjector;
+    panelContent_.release();
+}
+
 void Renderer::setProjectorImage(const cv::Mat& projectorImage) {
     if (projectorImage.empty()) {
         if (projectorImage_.empty())

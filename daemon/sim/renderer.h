@@ -56,6 +56,11 @@ public:
     // projector image is shown instead.
     void setContent(const cv::Mat& displayContent);
 
+    // From now on the display is displaySize pixels drawn onto the panel through displayToProjector (the
+    // keystone), and the truth gives display coordinates of that display. The content must come again, of
+    // the new size, before the next frame that shows it.
+    void setDisplay(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector);
+
     // From the next frame on the projector shows `projectorImage` (8-bit gray or BGR, projector size, panel
     // pixels: not warped through the display's keystone) instead of the content, the code embedded in it as
     // always. An empty image returns to the content. Throws std::invalid_argument for another size or type.

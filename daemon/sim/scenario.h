@@ -31,6 +31,9 @@ public:
     virtual double cycleSeconds() const = 0;
     // Every arrangement of props the scenario holds still (the exposure is metered for the brightest).
     virtual std::vector<Props> stillProps() const { return {}; }
+    // The session is a user following the calibration dialogue: it begins when the projector first shows an
+    // image (the dialogue's chessboard), and until then the scene is as at its start (Simulator::render).
+    virtual bool beginsWithTheProjector() const { return false; }
 };
 
 struct ScenarioContext {

@@ -40,19 +40,17 @@ Simulator::Simulator(const SimParameters& parameters, const cv::Mat& pattern, co
     if (pattern.type() != CV_8UC1 || pattern.size() != calibration_.projectorSize)
         throw std::invalid_argument("pattern: expected a CV_8UC1 image of the projector's size");
     pattern_ = pattern.clone();
+    nextIndex_ = firstFrame();
     scenario_ = makeScenario(parameters_.scenario, {calibration_, parameters_.seed, parameters_.handScale});
     renderer_ = std::make_unique<Renderer>(parameters_, calibration_, pattern_);
     if (!contentImage.empty()) {
-        cv::Mat bgr, scaled;
         if (contentImage.type() == CV_8UC1)
-            cv::cvtColor(contentImage, bgr, cv::COLOR_GRAY2BGR);
+            cv::cvtColor(contentImage, fixedImage_, cv::COLOR_GRAY2BGR);
         else if (contentImage.type() == CV_8UC3)
-            bgr = contentImage;
+            fixedImage_ = contentImage.clone();
         else
             throw std::invalid_argument("content: expected an 8-bit gray or BGR image");
-        cv::resize(bgr, scaled, calibration_.displaySize, 0, 0, cv::INTER_AREA);
-        renderer_->setContent(scaled);
-        fixedImage_ = true;
+        showFixedImage();
     } else if (parameters_.content != "auto") {
         fixedKind_ = contentKindFromName(parameters_.content);
         if (!fixedKind_)
@@ -86,8 +84,46 @@ double Simulator::ambientLux(double seconds) const {
     return parameters_.ambientLux;
 }
 
+void Simulator::projectImage(const cv::Mat& projectorImage) {
+    renderer_->setProjectorImage(projectorImage);
+    if (!projectorImage.empty() && !userStartS_)
+        userStartS_ = frameSeconds(nextIndex_);
+}
+
+SceneState Simulator::sceneAt(double seconds) const {
+    if (!scenario_->beginsWithTheProjector())
+        return scenario_->at(seconds);
+    return scenario_->at(userStartS_ ? seconds - *userStartS_ : 0.0);
+}
+
+void Simulator::setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
+    if (displaySize.width <= 0 || displaySize.height <= 0)
+        throw std::invalid_argument("display size: expected a positive width and height");
+    if (!displayToProjector.allFinite() || std::abs(displayToProjector.determinant()) < 1e-12 ||
+        displayToProjector(2, 2) == 0.0)
+        throw std::invalid_argument("display to projector: expected a finite, invertible homography");
+    const Eigen::Matrix3d normalised = displayToProjector / displayToProjector(2, 2);
+    if (displaySize == calibration_.displaySize &&
+        normalised.isApprox(calibration_.displayToProjector, 1e-12))
+        return;
+    calibration_.displaySize = displaySize;
+    calibration_.displayToProjector = normalised;
+    renderer_->setDisplay(displaySize, normalised);
+    // Hands reach for what the display shows where it now shows it.
+    scenario_ = makeScenario(parameters_.scenario, {calibration_, parameters_.seed, parameters_.handScale});
+    if (!fixedImage_.empty())
+        showFixedImage();
+    shown_.reset();
+}
+
+void Simulator::showFixedImage() {
+    cv::Mat scaled;
+    cv::resize(fixedImage_, scaled, calibration_.displaySize, 0, 0, cv::INTER_AREA);
+    renderer_->setContent(scaled);
+}
+
 void Simulator::showContent(const SceneState& scene) {
-    if (fixedImage_)
+    if (!fixedImage_.empty())
         return;
     const std::pair<ContentKind, int> wanted =
         fixedKind_ ? std::pair<ContentKind, int>(*fixedKind_, scene.contentVariant)
@@ -120,27 +156,28 @@ void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& trut
     const double exposure = exposureMs_ / 1000.0;
     // The scene at mid-exposure; hands that move are also rendered at more instants of the exposure, about
     // one per camera pixel they travel, and the image averages them.
-    const SceneState middle = scenario_->at(start + exposure / 2.0);
+    const SceneState middle = sceneAt(start + exposure / 2.0);
     showContent(middle);
     // Props in motion are cast with one sample per pixel at mid-exposure; still ones in full.
-    const bool still = middle.props.empty() || (middle.props == scenario_->at(start).props &&
-                                                middle.props == scenario_->at(start + exposure).props);
+    const bool still = middle.props.empty() || (middle.props == sceneAt(start).props &&
+                                                middle.props == sceneAt(start + exposure).props);
     renderer_->setProps(middle.props, still);
     int instants = 1;
     if (parameters_.motionSamples > 1 && !middle.hands.empty()) {
-        const double pixels = 2.0 * travelMm(middle, scenario_->at(start + exposure)) / mmPerCameraPixel_;
+        const double pixels = 2.0 * travelMm(middle, sceneAt(start + exposure)) / mmPerCameraPixel_;
         instants = std::min(parameters_.motionSamples,
                             1 + 2 * static_cast<int>(std::ceil(std::max(0.0, pixels - 1.0) / 2.0)));
     }
     exposureHands_.resize(instants);
     for (int i = 0; i < instants; ++i)
         exposureHands_[i] =
-            i == instants / 2 ? middle.hands : scenario_->at(start + (i + 0.5) / instants * exposure).hands;
+            i == instants / 2 ? middle.hands : sceneAt(start + (i + 0.5) / instants * exposure).hands;
     frame.index = index;
     frame.timestampUs = frameTimestampUs(index);
     frame.polarity = framePolarity(index);
     renderer_->render(exposureHands_, frame.polarity, ambientLux(start + exposure / 2.0), exposureMs_,
                       mix(parameters_.seed ^ mix(index)), frame.image, truth);
+    nextIndex_ = index + 1;
 }
 
 }  // namespace everytouch::sim

@@ -20,7 +20,8 @@ cv::Mat rigPattern(const SimParameters& parameters);
 
 // The simulated rig: a scenario played on the renderer. Frame k is exposed at k / frameRate seconds and shows
 // I = O + P for even k, I' = O - P for odd k; everything in it follows from the parameters, the pattern, the
-// content and k, so any frame can be rendered alone and again.
+// content, what the projector was given to show and the keystone, and k, so any frame can be rendered alone
+// and again.
 class Simulator {
 public:
     // pattern: CV_8UC1, projector size, 0/1 (rigPattern(parameters) for the rig). contentImage: when not
@@ -49,15 +50,29 @@ public:
     // From the next rendered frame on the projector shows `projectorImage` (8-bit gray or BGR, exactly the
     // projector's size, panel pixels, not warped through display_to_projector) instead of the content; the
     // code stays embedded (I = O + P, I' = O - P). An empty image returns to the content. Throws
-    // std::invalid_argument for another size or type.
-    void projectImage(const cv::Mat& projectorImage) { renderer_->setProjectorImage(projectorImage); }
+    // std::invalid_argument for another size or type. The first image begins the session of a scenario that
+    // follows the calibration dialogue (Scenario::beginsWithTheProjector) with the frame after the last one
+    // rendered.
+    void projectImage(const cv::Mat& projectorImage);
+
+    // From the next rendered frame on the desktop is a display of displaySize pixels drawn onto the panel
+    // through displayToProjector, as the daemon's calibration asks, instead of the rig's own keystone:
+    // calibration() and the truth's display coordinates describe that display, the content is drawn at its
+    // size, and the scenario's hands go where it shows them. Throws std::invalid_argument for an empty size
+    // or a homography that is not finite and invertible.
+    void setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector);
 
     // Renders frame `index` into `frame` (image, timestamp, index, polarity) and `truth`. The frame's
     // timestamp is the start of its exposure; the truth describes the scene at mid-exposure.
     void render(std::uint64_t index, core::Frame& frame, FrameTruth& truth);
 
 private:
+    // The scene at `seconds` of the stream: the scenario's, shifted to begin with the first projected image
+    // when it follows the calibration dialogue.
+    SceneState sceneAt(double seconds) const;
     void showContent(const SceneState& scene);
+    // The content image, scaled to the display.
+    void showFixedImage();
     // Largest distance a wrist or fingertip moves between two scenes, mm.
     static double travelMm(const SceneState& from, const SceneState& to);
 
@@ -67,11 +82,13 @@ private:
     std::unique_ptr<Scenario> scenario_;
     std::unique_ptr<Renderer> renderer_;
     std::optional<ContentKind> fixedKind_;  // content=KIND
-    bool fixedImage_ = false;               // content from an image
+    cv::Mat fixedImage_;                    // content from an image (BGR), as given
     std::optional<std::pair<ContentKind, int>> shown_;
     double exposureMs_ = 0.0;
     double mmPerCameraPixel_ = 1.0;  // on the table at the image centre
     std::vector<std::vector<HandPose>> exposureHands_;
+    std::uint64_t nextIndex_ = 0;       // the frame after the last one rendered
+    std::optional<double> userStartS_;  // stream time of the first projected image
 };
 
 }  // namespace everytouch::sim

@@ -5,7 +5,6 @@
 #include <sys/un.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -21,17 +20,41 @@ NotifySocket::NotifySocket(const std::filesystem::path& path) : path_(path) {
     std::strcpy(address.sun_path, path.c_str());
     if (::bind(fd_, reinterpret_cast<const sockaddr*>(&address), sizeof address) < 0)
         throw std::runtime_error("cannot bind the notify socket " + path.string());
+    reader_ = std::thread([this] { read(); });
 }
 
 NotifySocket::~NotifySocket() {
+    stopping_ = true;
+    reader_.join();
     ::close(fd_);
     ::unlink(path_.c_str());
 }
 
-bool NotifySocket::seen(const std::string& line, std::size_t from) const {
+void NotifySocket::read() {
+    // Polls briefly, so that the destructor's stop is seen soon.
+    constexpr int kPollMs = 50;
+    while (!stopping_) {
+        pollfd readable{fd_, POLLIN, 0};
+        if (::poll(&readable, 1, kPollMs) <= 0)
+            continue;
+        std::lock_guard lock(mutex_);
+        if (drain())
+            arrived_.notify_all();
+    }
+}
+
+bool NotifySocket::drain() {
+    bool any = false;
+    char buffer[4096];
+    for (ssize_t n; (n = ::recv(fd_, buffer, sizeof buffer, MSG_DONTWAIT)) > 0; any = true)
+        messages_.emplace_back(buffer, static_cast<std::size_t>(n));
+    return any;
+}
+
+bool NotifySocket::seen(const std::string& line) const {
     const bool prefix = !line.empty() && line.back() == '=';
-    for (std::size_t i = from; i < messages_.size(); ++i) {
-        std::istringstream lines(messages_[i]);
+    for (const std::string& message : messages_) {
+        std::istringstream lines(message);
         for (std::string candidate; std::getline(lines, candidate);)
             if (prefix ? candidate.starts_with(line) : candidate == line)
                 return true;
@@ -40,23 +63,14 @@ bool NotifySocket::seen(const std::string& line, std::size_t from) const {
 }
 
 bool NotifySocket::waitFor(const std::string& line, std::chrono::milliseconds timeout) {
-    if (seen(line, 0))
-        return true;
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (true) {
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-            deadline - std::chrono::steady_clock::now());
-        pollfd readable{fd_, POLLIN, 0};
-        if (::poll(&readable, 1, static_cast<int>(std::max<long>(left.count(), 0))) <= 0)
-            return false;
-        char buffer[4096];
-        const ssize_t n = ::recv(fd_, buffer, sizeof buffer, 0);
-        if (n <= 0)
-            continue;
-        messages_.emplace_back(buffer, static_cast<std::size_t>(n));
-        if (seen(line, messages_.size() - 1))
-            return true;
-    }
+    std::unique_lock lock(mutex_);
+    drain();  // what was sent before this call counts even with no time to wait
+    return arrived_.wait_for(lock, timeout, [&] { return seen(line); });
+}
+
+std::vector<std::string> NotifySocket::messages() const {
+    std::lock_guard lock(mutex_);
+    return messages_;
 }
 
 }  // namespace everytouch::test

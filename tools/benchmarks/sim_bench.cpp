@@ -95,6 +95,9 @@ void BM_RenderBoardMoving(benchmark::State& state) {
     sim::SimParameters p;
     p.scenario = "pair-calibration";
     sim::Simulator simulator(p, benchPattern(p.projectorSize));
+    cv::Mat chessboard;
+    core::renderProjectorChessboard(sim::calibrationChessboard(), p.projectorSize, chessboard);
+    simulator.projectImage(chessboard);  // the user begins when the dialogue shows it
     const auto& scenario = dynamic_cast<const sim::PairCalibrationScenario&>(simulator.scenario());
     core::Frame frame;
     sim::FrameTruth truth;

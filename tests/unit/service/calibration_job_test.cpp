@@ -26,11 +26,15 @@ std::vector<core::FramePair> pairsNumbered(std::size_t count, std::uint64_t firs
 }
 
 // Steps whose estimators shift the display by their step number, so the test can see which results were
-// chained through.
+// chained through; each leaves a one-pixel scene of its shift and notes the scene the step before left (-1
+// for none).
 CalibrationStep shiftingStep(const std::string& name, double shift, double rmsPx,
-                             std::vector<std::size_t>& pairsSeen) {
+                             std::vector<std::size_t>& pairsSeen, std::vector<int>* scenesSeen = nullptr) {
     return {name, name + " description",
-            [name, shift, rmsPx, &pairsSeen](const StepContext& context) -> EstimateResult {
+            [name, shift, rmsPx, &pairsSeen, scenesSeen](const StepContext& context) -> EstimateResult {
+                if (scenesSeen)
+                    scenesSeen->push_back(
+                        context.previousScene.empty() ? -1 : context.previousScene.at<uchar>(0, 0));
                 context.show(cv::Mat(context.projectorSize, CV_8UC1, cv::Scalar(255)));
                 context.progress(0.0, name + " prompt");
                 const std::optional<std::vector<core::FramePair>> pairs =
@@ -39,7 +43,8 @@ CalibrationStep shiftingStep(const std::string& name, double shift, double rmsPx
                     return core::Failure{"no frames"};
                 pairsSeen.push_back(pairs->size());
                 context.progress(0.5, name + " estimating");
-                Estimate estimate{context.current.value_or(test::paperLikeCalibration()), rmsPx};
+                Estimate estimate{context.current.value_or(test::paperLikeCalibration()), rmsPx,
+                                  cv::Mat(1, 1, CV_8UC1, cv::Scalar(shift))};
                 estimate.calibration.displayToProjector(0, 2) += shift;
                 return estimate;
             }};
@@ -73,8 +78,9 @@ TEST(CalibrationJob, OptionsAreRangeChecked) {
 
 TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
     std::vector<std::size_t> pairsSeen;
-    const std::vector<CalibrationStep> steps = {shiftingStep("first", 1.0, 0.2, pairsSeen),
-                                                shiftingStep("second", 10.0, 0.4, pairsSeen)};
+    std::vector<int> scenesSeen;
+    const std::vector<CalibrationStep> steps = {shiftingStep("first", 1.0, 0.2, pairsSeen, &scenesSeen),
+                                                shiftingStep("second", 10.0, 0.4, pairsSeen, &scenesSeen)};
     CalibrationOptions options;
     options.pairsPerStep = 3;
     std::uint64_t nextIndex = 0;
@@ -95,6 +101,7 @@ TEST(CalibrationJob, RunsStepsInOrderChainingTheirResults) {
     ASSERT_TRUE(outcome.ok) << outcome.message;
     EXPECT_EQ(requested, (std::vector<std::size_t>{3, 3}));
     EXPECT_EQ(pairsSeen, (std::vector<std::size_t>{3, 3}));
+    EXPECT_EQ(scenesSeen, (std::vector<int>{-1, 1}));
     EXPECT_EQ(shown, (std::vector<cv::Size>{{640, 480}, {640, 480}}));
     ASSERT_TRUE(outcome.calibration);
     EXPECT_DOUBLE_EQ(outcome.calibration->displayToProjector(0, 2), 11.0);

@@ -61,11 +61,13 @@ public:
             offeredAtShow = feeder_->offered();
     }
     void release() noexcept override { ++releases; }
+    void setDisplayToProjector(cv::Size, const Eigen::Matrix3d&) override { ++keystones; }
     cv::Size size() const override { return {64, 48}; }
     std::string describe() const override { return "a test projector"; }
 
     std::atomic<int> shows{0};
     std::atomic<int> releases{0};
+    std::atomic<int> keystones{0};
     std::atomic<std::uint64_t> offeredAtShow{0};
 
 private:
@@ -115,7 +117,7 @@ CalibrationStep capturingStep(std::size_t pairs, std::atomic<std::uint64_t>& fir
                 if (!captured)
                     return core::Failure{"no frames"};
                 firstCaptured = captured->front().latest().index;
-                return Estimate{test::paperLikeCalibration(), 0.25};
+                return Estimate{test::paperLikeCalibration(), 0.25, cv::Mat()};
             }};
 }
 
@@ -138,6 +140,8 @@ TEST(CalibrationRunner, ShowsTheImageSkipsThePairsThatPredateItAndGivesTheProjec
     EXPECT_DOUBLE_EQ(outcome.rmsPx, 0.25);
     EXPECT_EQ(projector.shows, 1);
     EXPECT_EQ(report.releasesAtFinish(), 1);
+    // The keystone changes when the daemon makes the outcome active, not before.
+    EXPECT_EQ(projector.keystones, 0);
     // The queue's worth of pairs and two more after the image changed may predate it: the step never sees
     // them.
     EXPECT_GT(firstCaptured.load(), projector.offeredAtShow + kQueueFrames + 2);

@@ -131,10 +131,11 @@ TEST(Snapshot, OverlayDrawsTheDisplayOutlineAndTheContactsWhereTheCalibrationPut
         EXPECT_TRUE(cv::Rect({}, overlay.size()).contains(at)) << at;
         return overlay.at<cv::Vec3b>(at);
     };
-    // The paper's camera sees the bottom of the projected display (the top lies beyond its frame).
-    const double bottom = calibration.displaySize.height;
+    // The paper's camera sees the bottom of the projected display (the top lies beyond its frame). Its
+    // outline runs along the outer edges of its pixels, half a pixel beyond the centres of the last ones.
+    const double bottom = calibration.displaySize.height - 0.5;
     for (const cv::Point2d corner :
-         {cv::Point2d(0, bottom), cv::Point2d(calibration.displaySize.width, bottom)}) {
+         {cv::Point2d(-0.5, bottom), cv::Point2d(calibration.displaySize.width - 0.5, bottom)}) {
         const cv::Point at = cameraPixelOf(calibration, corner, 0.0);
         EXPECT_GT(colourAt(at)[1], 200) << "no outline at the display corner seen at " << at;
     }

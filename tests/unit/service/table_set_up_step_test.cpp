@@ -3,7 +3,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/code_image.h"
 #include "core/geometry.h"
+#include "core/gray_frame.h"
 #include "support/surface_renderer.h"
 #include "support/test_rig.h"
 
@@ -131,8 +133,16 @@ std::vector<core::FramePair> sceneStream(
     return stream;
 }
 
+// The scene a pair shows without the code, in gray: what a step leaves as its Estimate::scene.
+cv::Mat grayTexture(const core::FramePair& pair) {
+    cv::Mat subtraction, texture, gray;
+    core::computeSubtractionAndTexture(pair, subtraction, texture);
+    EXPECT_TRUE(core::grayFrame(texture, gray).ok());
+    return gray;
+}
+
 EstimateResult runAfterAnotherStep(const std::vector<core::FramePair>& stream, const core::Calibration& rig,
-                                   double viewTimeoutS) {
+                                   double viewTimeoutS, const cv::Mat& previousScene) {
     CalibrationOptions options;
     options.pairsPerStep = 4;
     options.viewTimeoutS = viewTimeoutS;
@@ -151,7 +161,7 @@ EstimateResult runAfterAnotherStep(const std::vector<core::FramePair>& stream, c
                               },
                               [](const cv::Mat&) {},
                               [](double, const std::string&) {},
-                              true};
+                              previousScene};
     return setUpTableStep(context);
 }
 
@@ -165,13 +175,33 @@ TEST(TableSetUpStep, AfterAnotherStepWaitsUntilTheBoardIsTakenAway) {
     const std::vector<core::FramePair> board =
         capturedPairs(test::onSurface(rig, tilt), std::nullopt, 1, 2.0);
     const std::vector<core::FramePair> table = capturedPairs(rig, stripeBelowTheBoard(rig), 2, 2.0);
-    const EstimateResult result = runAfterAnotherStep(sceneStream({{board, 1.0}, {table, 2.0}}), rig, 10.0);
+    const cv::Mat lastPose = grayTexture(board.front());
+    const EstimateResult result =
+        runAfterAnotherStep(sceneStream({{board, 1.0}, {table, 2.0}}), rig, 10.0, lastPose);
     ASSERT_TRUE(result.ok()) << result.failure().message;
     EXPECT_LT(result->rmsPx, 0.5);
+    EXPECT_EQ(result->scene.size(), rig.cameraSize);
+    EXPECT_EQ(result->scene.type(), CV_8UC1);
 
-    const EstimateResult waited = runAfterAnotherStep(sceneStream({{board, 3.0}}), rig, 2.0);
+    const EstimateResult waited = runAfterAnotherStep(sceneStream({{board, 3.0}}), rig, 2.0, lastPose);
     ASSERT_FALSE(waited.ok());
     EXPECT_EQ(waited.failure().message, "the scene did not change and hold still again within 2 s");
+}
+
+TEST(TableSetUpStep, AfterAnotherStepTakesABoardGoneBeforeItBegan) {
+    // The user took the board away while the step before was still estimating: the first pair this step
+    // sees already shows the table.
+    const core::Calibration rig = distortedRig();
+    const Eigen::Vector3d middle(160, 230, 0);
+    const Eigen::Isometry3d tilt = Eigen::Translation3d(middle + Eigen::Vector3d(0, 0, 50)) *
+                                   Eigen::AngleAxisd(20 * M_PI / 180, Eigen::Vector3d::UnitY()) *
+                                   Eigen::Translation3d(-middle);
+    const cv::Mat lastPose =
+        grayTexture(capturedPairs(test::onSurface(rig, tilt), std::nullopt, 1, 2.0).front());
+    const std::vector<core::FramePair> table = capturedPairs(rig, stripeBelowTheBoard(rig), 2, 2.0);
+    const EstimateResult result = runAfterAnotherStep(sceneStream({{table, 2.0}}), rig, 10.0, lastPose);
+    ASSERT_TRUE(result.ok()) << result.failure().message;
+    EXPECT_LT(result->rmsPx, 0.5);
 }
 
 }  // namespace

@@ -243,7 +243,8 @@ TEST(PairCalibrationScenario, PosesAreWhatTheCalibrationNeeds) {
         }
         for (size_t i = 0; i < normals.size(); ++i)
             for (size_t j = i + 1; j < normals.size(); ++j)
-                EXPECT_GE(std::acos(std::min(1.0, normals[i].dot(normals[j]))) * 180.0 / M_PI, 10.0)
+                EXPECT_GE(std::acos(std::min(1.0, normals[i].dot(normals[j]))) * 180.0 / M_PI,
+                          PairCalibrationScenario::kMinTiltDifferenceDeg)
                     << "surfaces " << i << " and " << j << ", seed " << seed;
     }
 }
@@ -261,10 +262,11 @@ TEST(PairCalibrationScenario, ARigWithoutRoomForTheCardIsRefusedWithTheReason) {
     }
 }
 
-TEST(PairCalibrationScenario, HoldsSixStillScenesAndMovesBetweenThem) {
+TEST(PairCalibrationScenario, HoldsSevenStillScenesAndMovesBetweenThem) {
     SimParameters p;
     p.scenario = "pair-calibration";
     Simulator simulator(p, randomPattern(p.projectorSize));
+    simulator.projectImage(cv::Mat(p.projectorSize, CV_8UC1, cv::Scalar(255)));  // the session begins
     const auto& scenario = dynamic_cast<const PairCalibrationScenario&>(simulator.scenario());
     // Runs of frames showing the same props, at the rig's frame rate, over one cycle and a second beyond.
     const auto frames = static_cast<std::uint64_t>((scenario.cycleSeconds() + 1.0) * p.frameRate);
@@ -283,33 +285,62 @@ TEST(PairCalibrationScenario, HoldsSixStillScenesAndMovesBetweenThem) {
         previous = props;
         runStart = k;
     }
-    ASSERT_EQ(stillSeconds.size(), 6u);
-    EXPECT_FALSE(withBoard[0]);
-    for (size_t k = 0; k < stillSeconds.size(); ++k) {
+    // The table, five tilts of the board, and the table again once the board is taken away.
+    ASSERT_EQ(stillSeconds.size(), 7u);
+    EXPECT_FALSE(withBoard.front());
+    EXPECT_FALSE(withBoard.back());
+    for (size_t k = 0; k + 1 < stillSeconds.size(); ++k) {
         EXPECT_GE(stillSeconds[k], PairCalibrationScenario::kHoldSeconds - 0.02) << "pose " << k;
         if (k > 0) {
             EXPECT_TRUE(withBoard[k]);
         }
     }
+    EXPECT_TRUE(scenario.at(scenario.tableAgainAt()).props == (Props{scenario.poses().front().card, {}}));
 
-    // Frames in a move differ from each other well beyond the noise; frames in a hold do not.
-    const auto moving = static_cast<std::uint64_t>((scenario.holdEnd(2) + 0.5) * p.frameRate) & ~1ull;
-    const FramePair a = renderPair(simulator, moving);
-    const FramePair b = renderPair(simulator, moving + 2);
-    const auto still = static_cast<std::uint64_t>((scenario.holdStart(3) + 0.5) * p.frameRate) & ~1ull;
-    const FramePair c = renderPair(simulator, still);
-    const FramePair d = renderPair(simulator, still + 2);
-    // Pixels that changed by more than 25 DN (the noise of a texture is about 2 DN).
+    // In the middle of every move, frames a tenth of a second apart differ well beyond the noise (the
+    // dialogue compares each frame with the first of a still spell of half a second); frames in a hold do
+    // not. Pixels that changed by more than 25 DN (the noise of a texture is about 2 DN).
     const auto changed = [](const cv::Mat& x, const cv::Mat& y) {
         cv::Mat difference, gray;
         cv::absdiff(x, y, difference);
         cv::cvtColor(difference, gray, cv::COLOR_BGR2GRAY);
         return cv::countNonZero(gray > 25) / static_cast<double>(gray.total());
     };
-    const double inMove = changed(a.texture, b.texture), inHold = changed(c.texture, d.texture);
-    RecordProperty("moving_changed_fraction", std::to_string(inMove));
-    EXPECT_GT(inMove, 0.002);  // the edges of board, card, stripe and shadow on white content
+    const auto pairAt = [&](double seconds) {
+        return renderPair(simulator, static_cast<std::uint64_t>(seconds * p.frameRate) & ~1ull);
+    };
+    const int last = static_cast<int>(scenario.poses().size()) - 1;
+    double leastInMove = 1.0;
+    for (int k = 1; k <= last + 1; ++k) {
+        const double middle = scenario.holdEnd(k - 1) + PairCalibrationScenario::kMoveSeconds / 2;
+        const double inMove = changed(pairAt(middle).texture, pairAt(middle + 0.1).texture);
+        RecordProperty("moving_changed_fraction_" + std::to_string(k), std::to_string(inMove));
+        leastInMove = std::min(leastInMove, inMove);
+    }
+    const double still = scenario.holdStart(3) + 0.5;
+    const double inHold = changed(pairAt(still).texture, pairAt(still + 0.1).texture);
+    EXPECT_GT(leastInMove, 0.002);  // the edges of board, card, stripe and shadow on white content
     EXPECT_LT(inHold, 1e-4);
+}
+
+TEST(PairCalibrationScenario, TheUserBeginsWhenTheProjectorFirstShowsTheChessboard) {
+    SimParameters p;
+    p.scenario = "pair-calibration";
+    Simulator simulator(p, randomPattern(p.projectorSize));
+    const auto& scenario = dynamic_cast<const PairCalibrationScenario&>(simulator.scenario());
+    const auto at = [&](double seconds) { return static_cast<std::uint64_t>(seconds * p.frameRate) & ~1ull; };
+    // Before the dialogue shows anything the card lies on the table, however long that takes.
+    const std::uint64_t waiting = at(scenario.holdStart(2) + 0.5);
+    FramePair pair = renderPair(simulator, waiting);
+    EXPECT_TRUE(pair.truth.props == (Props{scenario.poses().front().card, {}}));
+    // The session begins with the frame after the last one rendered.
+    simulator.projectImage(chessboardImage(p.projectorSize));
+    const std::uint64_t begun = waiting + 2;
+    pair = renderPair(simulator, begun + at(scenario.holdStart(1) + 0.5));
+    ASSERT_TRUE(pair.truth.props.board);
+    EXPECT_TRUE(pair.truth.props == (Props{scenario.poses()[1].card, scenario.poses()[1].board}));
+    pair = renderPair(simulator, begun + at(scenario.tableAgainAt() + 1.0));
+    EXPECT_TRUE(pair.truth.props == (Props{scenario.poses().front().card, {}}));
 }
 
 TEST(PairCalibrationScenario, ChessboardAndStripeOnEveryBoardPoseAgreeWithTheGeometry) {
