@@ -209,9 +209,11 @@ FingertipOptions rigFingertipOptions(const Calibration& calibration, double fing
 }
 
 void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, FingertipScratch& scratch,
-                    Fingertips& fingertips) {
+                    Fingertips& fingertips, const cv::Mat& judged) {
     if (auto problem = options.validate())
         throw std::invalid_argument(*problem);
+    if (!judged.empty() && (judged.type() != CV_8UC1 || judged.size() != handMask.size()))
+        throw std::invalid_argument("findFingertips: the judged region must be CV_8UC1 of the mask's size");
     fingertips.clear();
     scratch.found.clear();
     const double width = options.fingerWidthPx;
@@ -222,6 +224,20 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
     const double cosLimit = std::cos(options.maxAngleRad);
     const double cosArmward = std::cos(options.minArmAngleRad);
     const int lastX = handMask.cols - 1, lastY = handMask.rows - 1;
+    // The way out of what the mask knows at a point: towards the image's edge, or towards pixels nobody
+    // judged. Such an edge cuts an arm or a finger just as the image's does.
+    const auto outward = [&](const cv::Point& q) {
+        const auto unknown = [&](int x, int y) {
+            return x < 0 || y < 0 || x > lastX || y > lastY || (!judged.empty() && !judged.at<uchar>(y, x));
+        };
+        return cv::Point(unknown(q.x + 1, q.y) - unknown(q.x - 1, q.y),
+                         unknown(q.x, q.y + 1) - unknown(q.x, q.y - 1));
+    };
+    const auto atEdge = [&](const cv::Point& q) {
+        return q.x == 0 || q.y == 0 || q.x == lastX || q.y == lastY ||
+               (!judged.empty() && (!judged.at<uchar>(q.y, q.x - 1) || !judged.at<uchar>(q.y, q.x + 1) ||
+                                    !judged.at<uchar>(q.y - 1, q.x) || !judged.at<uchar>(q.y + 1, q.x)));
+    };
     for (size_t region = 0; region < scratch.contours.contours.size(); ++region) {
         const ContourSpan& span = scratch.contours.contours[region];
         const cv::Point* points = scratch.contours.points.data() + span.begin;
@@ -234,12 +250,13 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
                               scratch.arc[n - 1] + cv::norm(points[0] - points[n - 1]));
         if (contour.length() < 4.0 * step)
             continue;
-        // Where the region leaves the image: the outward normal of the edges it runs along, weighted by how
-        // far. A hand reaches into the image from its forearm, so this is the way back to the wrist.
+        // Where the region leaves what is known: the outward normal of the edges it runs along, weighted by
+        // how far. A hand reaches into the image from its forearm, so this is the way back to the wrist.
         int armwardX = 0, armwardY = 0;
         for (int i = 0; i < n; ++i) {
-            armwardX += (points[i].x == lastX) - (points[i].x == 0);
-            armwardY += (points[i].y == lastY) - (points[i].y == 0);
+            const cv::Point out = outward(points[i]);
+            armwardX += out.x;
+            armwardY += out.y;
         }
         Eigen::Vector2d armward(armwardX, armwardY);
         if (armward.norm() > 0.0)
@@ -280,10 +297,8 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
                     last = j, ++count;
             i = last + 1;
             bool onEdge = false;
-            for (int j = first; j <= last; ++j) {
-                const cv::Point& q = points[contour.wrap(j)];
-                onEdge = onEdge || q.x == 0 || q.y == 0 || q.x == lastX || q.y == lastY;
-            }
+            for (int j = first; j <= last && !onEdge; ++j)
+                onEdge = atEdge(points[contour.wrap(j)]);
             if (onEdge)
                 continue;
             int median = first;

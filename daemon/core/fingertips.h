@@ -104,9 +104,11 @@ struct FingertipScratch {
 
 // Paper eq. 13-15 on the outer contour of every region of `handMask` (CV_8UC1, 0 / nonzero), then each group
 // of candidates refined to a sub-pixel tip and its pad. The image's edge cuts hands and arms that reach
-// beyond it: no fingertip is taken where a group of candidates touches it. `fingertips` is cleared first.
-// Throws std::invalid_argument when the options are invalid or the mask is not CV_8UC1.
+// beyond it: no fingertip is taken where a group of candidates touches it. `judged` (CV_8UC1, the mask's
+// size, nonzero where the mask was decided; empty: everywhere) adds the edges of what a segmentation judged,
+// which cut hands the same way. `fingertips` is cleared first. Throws std::invalid_argument when the options
+// are invalid, the mask is not CV_8UC1 or `judged` does not fit it.
 void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, FingertipScratch& scratch,
-                    Fingertips& fingertips);
+                    Fingertips& fingertips, const cv::Mat& judged = cv::Mat());
 
 }  // namespace everytouch::core

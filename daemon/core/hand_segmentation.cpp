@@ -93,6 +93,8 @@ std::optional<std::string> SegmentationOptions::validate() const {
         return "cameraBlurPx: must be a non-negative number of pixels";
     if (!(fingerWidthMm > 0.0) || !std::isfinite(fingerWidthMm))
         return "fingerWidthMm: must be a positive number of millimetres";
+    if (!(smoothingWidths >= 0.0 && smoothingWidths <= 2.0))
+        return "smoothingWidths: must be from 0 to 2 finger widths";
     if (!(minElevationMm >= 0.0 && minElevationMm < elevation.maxHeightMm))
         return "minElevationMm: must be from 0 to the highest elevation measured";
     if (closingRadiusPx < 0)
@@ -162,6 +164,16 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
                 cv::countNonZero(onDisplay(cv::Rect(bx - reach, by - reach, 2 * reach + 1, 2 * reach + 1))) ==
                 (2 * reach + 1) * (2 * reach + 1);
 
+    judgedRegion_ = cv::Mat::zeros(calibration.cameraSize, CV_8UC1);
+    if (options_.method == SegmentationMethod::Paper) {
+        judgedRegion_(displayBox_).setTo(255);
+    } else {
+        for (int by = 0; by < blocks.height; ++by)
+            for (int bx = 0; bx < blocks.width; ++bx)
+                if (displayBlocks_.at<uchar>(by, bx))
+                    judgedRegion_(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx)).setTo(255);
+    }
+
     const Eigen::Matrix3d cameraToTable = calibration.tableToCameraHomography(0.0).inverse();
     const Eigen::Vector2d centre(calibration.cameraSize.width / 2.0, calibration.cameraSize.height / 2.0);
     const double mmPerPixel = (applyHomography(cameraToTable, centre + Eigen::Vector2d(0.5, 0)) -
@@ -194,6 +206,19 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     fill(colourKnown_, 0);
     growIntoFaintBlocks(texture);
     labelPixels(texture, subtraction, mask);
+
+    cv::Rect handBlocks;
+    for (int by = 0; by < blockClass_.rows; ++by)
+        for (int bx = 0; bx < blockClass_.cols; ++bx)
+            if (isHand(blockClass_.at<uchar>(by, bx)))
+                handBlocks |= cv::Rect(bx - 1, by - 1, 3, 3);  // with the outline's blocks around it
+    const int blockPx = options_.blockPx;
+    const int radius =
+        static_cast<int>(std::lround(0.5 * options_.smoothingWidths * options_.fingerWidthMm * pixelsPerMm_));
+    voteByMajority(mask,
+                   cv::Rect(handBlocks.x * blockPx, handBlocks.y * blockPx, handBlocks.width * blockPx,
+                            handBlocks.height * blockPx),
+                   radius, majorityScratch_);
 }
 
 void HandSegmenter::classifyBlocks() {
@@ -278,13 +303,40 @@ void HandSegmenter::classifyBlocks() {
 }
 
 bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
+    // Blocks on the component's rim have windows that see the table beside it, whose sharp code would pull
+    // the height down: the height is measured on the blocks whose neighbours are all in the component, on
+    // all of them when it has too few such blocks to tell.
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    const uchar* classes = blockClass_.ptr<uchar>();
+    const auto interior = [&](int i) {
+        const int y = i / cols, x = i % cols;
+        if (y == 0 || x == 0 || y == rows - 1 || x == cols - 1)
+            return false;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+                if (classes[(y + dy) * cols + x + dx] != Hand)
+                    return false;
+        return true;
+    };
+    int interiorCount = 0;
+    for (int k = 0; k < size; ++k)
+        interiorCount += interior(component_[k]);
+    const double blockMm = options_.blockPx / pixelsPerMm_;
+    const bool useInterior =
+        interiorCount * blockMm * blockMm >= options_.fingerWidthMm * options_.fingerWidthMm / 4;
+
     // The component's pixels, at most about kMaxPixels of them (a sample of its blocks).
     constexpr int kMaxPixels = 800;
-    const int blockPx = options_.blockPx, cols = blockClass_.cols;
+    const int blockPx = options_.blockPx;
     const int perBlock = blockPx * blockPx;
-    const int blockStride = std::max(1, size * perBlock / kMaxPixels);
+    const int used = useInterior ? interiorCount : size;
+    const int blockStride = std::max(1, used * perBlock / kMaxPixels);
     elevation_.clearPixels();
-    for (int k = 0; k < size; k += blockStride) {
+    for (int k = 0, n = 0; k < size; ++k) {
+        if (useInterior && !interior(component_[k]))
+            continue;
+        if (n++ % blockStride)
+            continue;
         const int y0 = component_[k] / cols * blockPx, x0 = component_[k] % cols * blockPx;
         for (int y = y0; y < y0 + blockPx; ++y)
             for (int x = x0; x < x0 + blockPx; ++x)

@@ -8,6 +8,7 @@
 
 #include "core/calibration.h"
 #include "core/code_evidence.h"
+#include "core/majority_filter.h"
 #include "core/mean_shift_segmentation.h"
 #include "core/saliency.h"
 #include "core/segment_confidence.h"
@@ -48,6 +49,10 @@ struct SegmentationOptions {
     // code's look, not a hand.
     double minElevationMm = 4.0;
     HeightOptions elevation;  // how the height of a region is measured
+    // The outline's pixels are decided one by one; a majority vote over a square this many finger widths
+    // wide then removes specks and notches narrower than a quarter of a finger (paper: a morphological
+    // closing), which the fingertip finder would take for the outline's shape.
+    double smoothingWidths = 0.5;
 
     // The paper's method.
     SaliencyOptions saliency;
@@ -74,6 +79,11 @@ public:
     // allocates nothing.
     void segment(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
+    // CV_8UC1, camera size: nonzero where the method decides hand or not (the display, less what a window at
+    // its edge cannot judge); elsewhere the mask is 0 for want of a look, and its edge cuts hands as the
+    // image's edge does. Empty before setRig.
+    const cv::Mat& judgedRegion() const { return judgedRegion_; }
+
     // Camera pixels per millimetre on the table near the image centre (from the calibration).
     double pixelsPerMm() const { return pixelsPerMm_; }
 
@@ -92,12 +102,11 @@ private:
     TableCode tableCode_;
     cv::Rect displayBox_;    // the display's bounding box in the camera
     cv::Mat displayBlocks_;  // CV_8UC1, block grid: 1 where the whole window lies on the display
+    cv::Mat judgedRegion_;
     double pixelsPerMm_ = 1.0;
     float litAmplitude_ = 0.0f;
     float tableAmplitude_ = 0.0f;  // mean S on the table in the last frame
     float noiseVariance_ = 0.0f;   // of S where only noise is seen (DN^2)
-    cv::Mat blockExpected_;  // CV_32FC1, block grid: the table code's correlation if the table were there  //
-                             // mean S below which a surface gets too little projector light to judge
 
     CodeEvidence evidence_;
     cv::Mat blockClass_;   // CV_8UC1, block grid
@@ -106,6 +115,7 @@ private:
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
+    MajorityScratch majorityScratch_;
     SurfaceHeight elevation_;
     HeightEvidence elevationEvidence_;
 

@@ -37,6 +37,8 @@ std::optional<std::string> HeightOptions::validate() const {
         return "skinScatterMm: must be in [0, 10) mm";
     if (!(regionWidths > 0.0 && regionWidths <= 3.0))
         return "regionWidths: must be in (0, 3] finger widths";
+    if (!(centreBehindWidths >= 0.0 && centreBehindWidths <= 3.0))
+        return "centreBehindWidths: must be in [0, 3] finger widths";
     if (!(significance > 0.0) || !std::isfinite(significance))
         return "significance: must be a positive number of standard deviations";
     return std::nullopt;
@@ -120,8 +122,7 @@ void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& 
                                      const Eigen::Vector2d& tip, const Eigen::Vector2d& direction,
                                      double widthPx, HeightEvidence& evidence) {
     CV_Assert(subtraction.type() == CV_16SC1 && handMask.type() == CV_8UC1);
-    // The round end of a finger seen from above: its middle lies half a width behind the silhouette's tip.
-    const Eigen::Vector2d centre = tip - 0.5 * widthPx * direction;
+    const Eigen::Vector2d centre = tip - options_.centreBehindWidths * widthPx * direction;
     const double radius = options_.regionWidths * widthPx;
     const int x0 = std::max(1, static_cast<int>(std::floor(centre.x() - radius)));
     const int x1 = std::min(subtraction.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));

@@ -22,8 +22,11 @@ struct HeightOptions {
     // Light spreads inside skin before it leaves it (Gaussian sigma, mm): about a millimetre for red light,
     // which blurs the code on a finger beyond what the camera resolves.
     double skinScatterMm = 0.8;
-    // The fingertip region: hand pixels within this many finger widths of the middle of the fingertip.
-    double regionWidths = 0.6;
+    // The fingertip region: hand pixels within regionWidths finger widths of a point centreBehindWidths
+    // behind the silhouette's end: the last joint's end, whose height follows the pad's more closely than
+    // the finger's back further up, which tilts with the finger.
+    double regionWidths = 0.5;
+    double centreBehindWidths = 0.25;
     // A correlation must exceed this many standard deviations of chance to count as seeing the code.
     double significance = 3.0;
 

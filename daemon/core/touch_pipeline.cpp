@@ -109,7 +109,8 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     result_.detecting = true;
     result_.idleReason.clear();
     segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
-    findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_);
+    findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_,
+                   segmenter_.judgedRegion());
     measureFingertips(settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);

@@ -37,9 +37,11 @@ struct DetectionOptions {
     TrackerOptions tracker;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
     double fingerWidthMm = 16.0;
-    // How far above its pad the camera sees the back of a fingertip (mm), half a finger width behind its
-    // end: fingertips are 12-15 mm thick and round, so the surface seen there lies about 9 mm up.
-    double visibleAbovePadMm = 9.0;
+    // How far above its pad the camera sees the back of a fingertip (mm), in the region the height is
+    // measured on (HeightOptions): fingertips are 12-15 mm thick and round and tilt up towards the hand, so
+    // the surface seen there lies about 11 mm up. The simulated hand measures 11-12.5 mm within 10 mm of the
+    // table (docs/detection.md). Each finger's own thickness is not learned yet.
+    double visibleAbovePadMm = 11.0;
     // Evidence of earlier frames counts this much less each frame while a fingertip stays put (moves less
     // than a tenth of its width): a half-life of about two frames keeps a touch-down's latency at one frame.
     double evidenceDecay = 0.7;

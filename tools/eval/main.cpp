@@ -191,7 +191,8 @@ CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
         ->check(CLI::PositiveNumber);
     command
         ->add_option("--touch-height-mm", arguments.touchHeightMm,
-                     "Touch height the pipeline runs with (without LOG)")
+                     "Touch height the contacts are detected with (the pipeline's without LOG, the daemon's "
+                     "with it); a touch-down while a true pad is this low is not false")
         ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     command
@@ -231,6 +232,7 @@ int runTouches(const TouchArguments& arguments) {
     eval::TouchScoringOptions options;
     options.matchRadiusPx = eval::matchRadiusPx(recording.rig().calibration, arguments.matchRadiusMm);
     options.highHoverMm = arguments.highHoverMm;
+    options.touchHeightMm = arguments.touchHeightMm;
     if (const auto problem = options.validate())
         throw io::InputError(arguments.recording + "/rig.yml", "", *problem);
     const eval::TouchScore score = eval::scoreTouches(eval::truthFrames(recording), detected, options);

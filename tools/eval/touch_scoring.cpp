@@ -66,6 +66,8 @@ bool wasTouching(const core::Contacts& contacts, std::uint32_t id) {
 std::optional<std::string> TouchScoringOptions::validate() const {
     if (!(matchRadiusPx > 0.0) || !std::isfinite(matchRadiusPx))
         return "the match radius must be a positive number of display pixels";
+    if (!(touchHeightMm >= 0.0) || !std::isfinite(touchHeightMm))
+        return "the touch height must be a non-negative number of mm";
     if (!(highHoverMm > 0.0) || !std::isfinite(highHoverMm))
         return "the high hover height must be a positive number of mm";
     return std::nullopt;
@@ -134,7 +136,8 @@ TouchScore scoreTouches(const TruthFrames& truth, const DetectedFrames& detected
             ++score.touchDowns;
             const bool explained =
                 std::any_of(fingers.begin(), fingers.end(), [&](const core::FingerTruth& f) {
-                    return f.heightMm == 0.0 && (pointOf(f) - pointOf(contact)).norm() <= radius;
+                    return f.heightMm <= options.touchHeightMm &&
+                           (pointOf(f) - pointOf(contact)).norm() <= radius;
                 });
             if (!explained)
                 score.phantoms.push_back({p, contact.id, pointOf(contact)});

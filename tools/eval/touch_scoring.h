@@ -22,6 +22,10 @@ struct TouchScoringOptions {
     // A true finger hovering at least this high must never be reported touching, mm (the paper's claim: no
     // touch is reported at 8 mm or more).
     double highHoverMm = 8.0;
+    // The touch height the contacts were detected with, mm: a finger whose pad is this close to the table
+    // touches by the product's own definition (TouchHeightMm, the paper's elevated plane), so a touch-down
+    // while a true pad within the radius is this low is early at worst, not false.
+    double touchHeightMm = 0.0;
 
     std::optional<std::string> validate() const;
 };

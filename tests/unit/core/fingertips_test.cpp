@@ -217,6 +217,28 @@ TEST(Fingertips, TheImageEdgeMakesNoFingertip) {
     expectFound(found, finger, 1);
 }
 
+TEST(Fingertips, TheEdgeOfWhatWasJudgedCutsLikeTheImageEdge) {
+    // A segmentation that judges only the display cuts a forearm at the display's edge (here y = 100): the
+    // corners of that cut are no fingertips, the finger inside the display is.
+    cv::Mat judged = cv::Mat::zeros(488, 648, CV_8UC1);
+    judged(cv::Rect(40, 100, 560, 360)).setTo(255);
+    cv::Mat mask = cv::Mat::zeros(488, 648, CV_8UC1);
+    fillCapsule(mask, {{300, 150}, Eigen::Vector2d(300, 150) + 300 * towards(-60), 30});
+    fillEllipse(mask, {300, 170}, 40, 32);
+    const Capsule finger{{300, 170}, {310, 300}, 9};
+    fillCapsule(mask, finger);
+    mask.setTo(0, judged == 0);
+    FingertipScratch scratch;
+    Fingertips found;
+    findFingertips(mask, drawnOptions(), scratch, found);
+    EXPECT_GT(found.size(), 1u) << "without the judged region the cut's corners look like fingertips";
+    findFingertips(mask, drawnOptions(), scratch, found, judged);
+    ASSERT_EQ(found.size(), 1u) << describe(found);
+    expectFound(found, finger, 0);
+    EXPECT_THROW(findFingertips(mask, drawnOptions(), scratch, found, judged(cv::Rect(0, 0, 10, 10))),
+                 std::invalid_argument);
+}
+
 TEST(Fingertips, AllocateNothingOnceWarm) {
     cv::Mat twoHands = cv::Mat::zeros(488, 648, CV_8UC1), oneHand = cv::Mat::zeros(488, 648, CV_8UC1);
     drawHand(twoHands, {180, 140}, true);

@@ -108,6 +108,24 @@ TEST(ScoreTouches, APhantomTouchIsAFalseAcceptance) {
     EXPECT_EQ(score.far(), 1.0);
 }
 
+TEST(ScoreTouches, ATouchDownWhileThePadIsWithinTheTouchHeightIsEarlyNotFalse) {
+    const TruthFrames truth = tap(1, 100);
+    DetectedFrames detected = perfect(truth);
+    detected[1][0].touching = true;  // at 4 mm, a frame before the pad lands
+    TouchScoringOptions withinFour = options();
+    withinFour.touchHeightMm = 4.0;
+    const TouchScore early = scoreTouches(truth, detected, withinFour);
+    EXPECT_EQ(early.touchDowns, 1);
+    EXPECT_TRUE(early.phantoms.empty());
+    EXPECT_EQ(early.latencyFrames.value(), 0.0);
+
+    TouchScoringOptions withinThree = options();
+    withinThree.touchHeightMm = 3.0;
+    const TouchScore tooEarly = scoreTouches(truth, detected, withinThree);
+    ASSERT_EQ(tooEarly.phantoms.size(), 1u);
+    EXPECT_EQ(tooEarly.phantoms[0].position, 1u);
+}
+
 TEST(ScoreTouches, ATouchAtEightMillimetresIsCounted) {
     const TruthFrames truth = tap(1, 100);
     DetectedFrames detected = perfect(truth);
