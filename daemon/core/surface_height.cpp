@@ -199,6 +199,11 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     result.correlation = bestCorrelation;
     if (bestCorrelation < options_.significance * chance)
         return result;
+    // A best height at the top of the range is no peak: the surface lies higher or the correlation rises
+    // for another reason (a region reaching onto the hand further up), and nothing says how high. The
+    // bottom of the range is the table, below which nothing lies.
+    if (best + 1 == count)
+        return result;
     // The peak to a fraction of a step: the parabola through the best height and its neighbours.
     double offset = 0.0;
     if (best > 0 && best + 1 < count && evidence.codeVariance[best - 1] > 0.0 &&

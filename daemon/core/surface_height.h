@@ -47,7 +47,9 @@ struct HeightEvidence {
 };
 
 struct HeightEstimate {
-    bool valid = false;          // the code was seen on the fingertip well enough to tell a height
+    // The code was seen on the fingertip well enough to tell a height, and its best height lies below the
+    // top of the range.
+    bool valid = false;
     double heightMm = 0.0;       // of the visible surface above the table
     double correlation = 0.0;    // at that height
     double uncertaintyMm = 0.0;  // one standard deviation

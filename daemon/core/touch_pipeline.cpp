@@ -40,6 +40,8 @@ std::optional<std::string> DetectionOptions::validate() const {
         return "fingerWidthMm: must be in (0, 50) mm";
     if (!(visibleAbovePadMm >= 0.0 && visibleAbovePadMm < 40.0))
         return "visibleAbovePadMm: must be in [0, 40) mm";
+    if (!(visibleSpreadMm >= 0.0 && visibleSpreadMm < 20.0))
+        return "visibleSpreadMm: must be in [0, 20) mm";
     if (!(evidenceDecay >= 0.0 && evidenceDecay < 1.0))
         return "evidenceDecay: must be in [0, 1)";
     return std::nullopt;
@@ -155,7 +157,7 @@ void TouchPipeline::measureFingertips(const PipelineSettings& settings) {
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
         finger.padHeightMm = observation.padHeightMm;
-        finger.heightUncertaintyMm = observation.visible.uncertaintyMm;
+        finger.heightUncertaintyMm = std::hypot(observation.visible.uncertaintyMm, options_.visibleSpreadMm);
     }
     std::swap(remembered_, rememberedNext_);
     rememberedCount_ = next;
