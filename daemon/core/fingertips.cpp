@@ -224,19 +224,18 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
     const double cosLimit = std::cos(options.maxAngleRad);
     const double cosArmward = std::cos(options.minArmAngleRad);
     const int lastX = handMask.cols - 1, lastY = handMask.rows - 1;
-    // The way out of what the mask knows at a point: towards the image's edge, or towards pixels nobody
-    // judged. Such an edge cuts an arm or a finger just as the image's does.
+    // Outside the image or outside what was judged, nothing is known: an edge there cuts an arm or a finger.
+    const auto unknown = [&](int x, int y) {
+        return x < 0 || y < 0 || x > lastX || y > lastY || (!judged.empty() && !judged.at<uchar>(y, x));
+    };
+    // The way out of what is known at a point, and whether it lies on that edge at all.
     const auto outward = [&](const cv::Point& q) {
-        const auto unknown = [&](int x, int y) {
-            return x < 0 || y < 0 || x > lastX || y > lastY || (!judged.empty() && !judged.at<uchar>(y, x));
-        };
         return cv::Point(unknown(q.x + 1, q.y) - unknown(q.x - 1, q.y),
                          unknown(q.x, q.y + 1) - unknown(q.x, q.y - 1));
     };
     const auto atEdge = [&](const cv::Point& q) {
-        return q.x == 0 || q.y == 0 || q.x == lastX || q.y == lastY ||
-               (!judged.empty() && (!judged.at<uchar>(q.y, q.x - 1) || !judged.at<uchar>(q.y, q.x + 1) ||
-                                    !judged.at<uchar>(q.y - 1, q.x) || !judged.at<uchar>(q.y + 1, q.x)));
+        return unknown(q.x + 1, q.y) || unknown(q.x - 1, q.y) || unknown(q.x, q.y + 1) ||
+               unknown(q.x, q.y - 1);
     };
     for (size_t region = 0; region < scratch.contours.contours.size(); ++region) {
         const ContourSpan& span = scratch.contours.contours[region];

@@ -50,8 +50,8 @@ struct SegmentationOptions {
     double minElevationMm = 4.0;
     HeightOptions elevation;  // how the height of a region is measured
     // The outline's pixels are decided one by one; a majority vote over a square this many finger widths
-    // wide then removes specks and notches narrower than a quarter of a finger (paper: a morphological
-    // closing), which the fingertip finder would take for the outline's shape.
+    // wide then removes specks and notches narrower than a quarter of a finger (where the paper's method
+    // closes), which the fingertip finder would take for the outline's shape.
     double smoothingWidths = 0.5;
 
     // The paper's method.
