@@ -179,6 +179,8 @@ std::optional<std::string> FingertipOptions::validate() const {
         return "fingertips min_width_ratio, max_width_ratio: need 0 < min < max";
     if (!(minRegionWidths2 >= 0.0))
         return "fingertips min_region_widths2: must not be negative";
+    if (!(edgeMarginWidths >= 0.0 && edgeMarginWidths <= 2.0))
+        return "fingertips edge_margin_widths: must be in [0, 2]";
     if (maxFingertips < 0)
         return "fingertips max_fingertips: must not be negative";
     if (!(padBackWidths >= 0.0))
@@ -233,9 +235,13 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
         return cv::Point(unknown(q.x + 1, q.y) - unknown(q.x - 1, q.y),
                          unknown(q.x, q.y + 1) - unknown(q.x, q.y - 1));
     };
-    const auto atEdge = [&](const cv::Point& q) {
-        return unknown(q.x + 1, q.y) || unknown(q.x - 1, q.y) || unknown(q.x, q.y + 1) ||
-               unknown(q.x, q.y - 1);
+    const int margin = std::max(1, static_cast<int>(std::lround(options.edgeMarginWidths * width)));
+    const auto nearEdge = [&](const cv::Point& q) {
+        for (int dy = -margin; dy <= margin; ++dy)
+            for (int dx = -margin; dx <= margin; ++dx)
+                if (unknown(q.x + dx, q.y + dy))
+                    return true;
+        return false;
     };
     for (size_t region = 0; region < scratch.contours.contours.size(); ++region) {
         const ContourSpan& span = scratch.contours.contours[region];
@@ -297,7 +303,7 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
             i = last + 1;
             bool onEdge = false;
             for (int j = first; j <= last && !onEdge; ++j)
-                onEdge = atEdge(points[contour.wrap(j)]);
+                onEdge = nearEdge(points[contour.wrap(j)]);
             if (onEdge)
                 continue;
             int median = first;

@@ -67,6 +67,10 @@ struct FingertipOptions {
     // thumb raised towards the camera, whose image the parallax pulls back over the hand. Fingers on or near
     // the table point 75 degrees or more away from that way.
     double minArmAngleRad = M_PI / 3.0;
+    // A group of candidates that comes this close to the edge of the image or of the judged region, finger
+    // widths, is the corner where that edge cuts an arm, rounded off by the mask's smoothing (a majority vote
+    // half a finger wide, HandSegmenter), not a fingertip.
+    double edgeMarginWidths = 0.25;
     // Most fingertips kept per frame: two hands. The sharpest are kept when there are more.
     int maxFingertips = 10;
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -22,10 +23,11 @@ enum BlockClass : uchar {
     Candidate = 3,  // lit, and not the table's code
     Hand = 4,       // a candidate in a region large enough to be a hand
     Grown = 5,      // too faint to tell by the code, joined to the hand by its colour
+    Touching = 6,   // shows the table's code, joined to the hand by its colour: a touching fingertip's end
 };
 
 bool isHand(uchar c) {
-    return c == Hand || c == Grown;
+    return c == Hand || c == Grown || c == Touching;
 }
 
 // Where in the sorted values the fraction lies (nth_element on a reused buffer).
@@ -69,6 +71,9 @@ constexpr float kSignificance = 3.0f;
 // The brightest code pixel shows twice the code's mean (half the bits are 1); noise and a brighter patch of
 // table add to that. Beyond this many times the table's mean, S is no longer code.
 constexpr float kMotionAmplitudes = 3.0f;
+// A block that shows the table's code joins a touching finger only when its colour is at least three times
+// nearer the hand's than the table's (squared distances nine times): the code, the stronger cue, says table.
+constexpr float kTouchingColourRatio = 9.0f;
 
 }  // namespace
 
@@ -158,6 +163,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     values_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
+    handDistance_.resize(blockCount);
     for (int by = reach; by < blocks.height - reach; ++by)
         for (int bx = reach; bx < blocks.width - reach; ++bx)
             displayBlocks_.at<uchar>(by, bx) =
@@ -205,6 +211,7 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     colourKnown_.create(blockClass_.size(), CV_8UC1);
     fill(colourKnown_, 0);
     growIntoFaintBlocks(texture);
+    growOverTouchingSkin(texture);
     labelPixels(texture, subtraction, mask);
 
     cv::Rect handBlocks;
@@ -436,6 +443,80 @@ void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
                                 tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
                 if (handDistance < tableDistance) {
                     classes[j] = Grown;
+                    queue_[tail++] = j;
+                }
+            }
+    }
+}
+
+void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
+    // The last millimetres of a touching finger lie too close to the table for the code to tell them from
+    // it: their blocks show the table's code. They lie within half a finger's width of where the code sees
+    // the finger, and their colour is the skin's: such blocks join the hand when their colour is nearer the
+    // hand's next to them than the table's beyond that reach.
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    uchar* classes = blockClass_.ptr<uchar>();
+    const double blockMm = options_.blockPx / pixelsPerMm_;
+    const int reach = std::max(1, static_cast<int>(std::lround(0.5 * options_.fingerWidthMm / blockMm)));
+    const int sampleReach = reach + 1;  // where the table's colour is sampled, beyond the reach
+
+    // Blocks to the nearest hand block, up to the farthest a table sample lies from the hand.
+    constexpr int kFar = std::numeric_limits<int>::max();
+    std::fill(handDistance_.begin(), handDistance_.end(), kFar);
+    int head = 0, tail = 0;
+    for (int i = 0; i < rows * cols; ++i)
+        if (isHand(classes[i])) {
+            handDistance_[i] = 0;
+            queue_[tail++] = i;
+        }
+    if (tail == 0)
+        return;
+    const int handBlocks = tail;
+    while (head < tail) {
+        const int i = queue_[head++];
+        if (handDistance_[i] >= reach + sampleReach)
+            continue;
+        const int y = i / cols, x = i % cols;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int ny = y + dy, nx = x + dx;
+                if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
+                    continue;
+                const int j = ny * cols + nx;
+                if (handDistance_[j] == kFar && classes[j] != Outside) {
+                    handDistance_[j] = handDistance_[i] + 1;
+                    queue_[tail++] = j;
+                }
+            }
+    }
+
+    head = 0;
+    tail = handBlocks;  // the hand blocks are still at the queue's front
+    while (head < tail) {
+        const int i = queue_[head++];
+        const int y = i / cols, x = i % cols;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int ny = y + dy, nx = x + dx;
+                if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
+                    continue;
+                const int j = ny * cols + nx;
+                if (classes[j] != Table || handDistance_[j] > reach)
+                    continue;
+                const float* colour = blockFeature(texture, ny, nx);
+                const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
+                float tableDistance = std::numeric_limits<float>::max();
+                for (int ty = std::max(ny - sampleReach, 0); ty <= std::min(ny + sampleReach, rows - 1); ++ty)
+                    for (int tx = std::max(nx - sampleReach, 0); tx <= std::min(nx + sampleReach, cols - 1);
+                         ++tx) {
+                        const int k = ty * cols + tx;
+                        if (classes[k] == Table && handDistance_[k] > reach)
+                            tableDistance = std::min(
+                                tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
+                    }
+                if (kTouchingColourRatio * handDistance < tableDistance &&
+                    tableDistance < std::numeric_limits<float>::max()) {
+                    classes[j] = Touching;
                     queue_[tail++] = j;
                 }
             }

@@ -96,6 +96,7 @@ private:
     // A block's mean colour as colourFeature makes it, measured on first use in a frame.
     const float* blockFeature(const cv::Mat& texture, int by, int bx);
     void growIntoFaintBlocks(const cv::Mat& texture);
+    void growOverTouchingSkin(const cv::Mat& texture);
     void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
     SegmentationOptions options_;
@@ -115,6 +116,7 @@ private:
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
+    std::vector<int> handDistance_;  // block grid: blocks to the nearest hand block (8-connected)
     MajorityScratch majorityScratch_;
     SurfaceHeight elevation_;
     HeightEvidence elevationEvidence_;

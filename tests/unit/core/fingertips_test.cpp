@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "core/geometry.h"
 #include "sim/rig_geometry.h"
@@ -237,6 +238,29 @@ TEST(Fingertips, TheEdgeOfWhatWasJudgedCutsLikeTheImageEdge) {
     expectFound(found, finger, 0);
     EXPECT_THROW(findFingertips(mask, drawnOptions(), scratch, found, judged(cv::Rect(0, 0, 10, 10))),
                  std::invalid_argument);
+}
+
+TEST(Fingertips, ACornerRoundedOffNearTheJudgedEdgeIsNoFingertip) {
+    // The mask's smoothing rounds the corners where the judged region's edge cuts a forearm, and may leave
+    // them a few pixels inside that edge: still corners, not fingertips.
+    cv::Mat judged = cv::Mat::zeros(488, 648, CV_8UC1);
+    judged(cv::Rect(40, 100, 560, 360)).setTo(255);
+    cv::Mat mask = cv::Mat::zeros(488, 648, CV_8UC1);
+    fillCapsule(mask, {{300, 150}, Eigen::Vector2d(300, 150) + 300 * towards(-150), 30});
+    fillEllipse(mask, {300, 170}, 40, 32);
+    const Capsule finger{{300, 170}, {310, 300}, 9};
+    fillCapsule(mask, finger);
+    mask(cv::Rect(0, 0, mask.cols, 104)).setTo(0);
+    cv::medianBlur(mask, mask, 11);
+    FingertipScratch scratch;
+    Fingertips found;
+    FingertipOptions onTheEdgeOnly = drawnOptions();
+    onTheEdgeOnly.edgeMarginWidths = 0.0;
+    findFingertips(mask, onTheEdgeOnly, scratch, found, judged);
+    EXPECT_GT(found.size(), 1u) << "the rounded corners off the edge look like fingertips";
+    findFingertips(mask, drawnOptions(), scratch, found, judged);
+    ASSERT_EQ(found.size(), 1u) << describe(found);
+    expectFound(found, finger, 0);
 }
 
 TEST(Fingertips, AllocateNothingOnceWarm) {
