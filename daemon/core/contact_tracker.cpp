@@ -24,6 +24,8 @@ std::optional<std::string> TrackerOptions::validate() const {
         return "maxSpeedMmPerS: must be a positive speed in mm/s";
     if (maxMissedFrames < 0)
         return "maxMissedFrames: must not be negative";
+    if (maxUnmeasuredFrames < 0)
+        return "maxUnmeasuredFrames: must not be negative";
     if (!(positionNoiseMm >= 0.0) || !std::isfinite(positionNoiseMm))
         return "positionNoiseMm: must be a non-negative number of millimetres";
     if (!(minHysteresisMm > 0.0) || !std::isfinite(minHysteresisMm))
@@ -106,7 +108,9 @@ void ContactTracker::update(std::int64_t timestampUs, const std::vector<FingerOb
     std::erase_if(tracks_, [&](const Track& track) { return track.missedFrames > options_.maxMissedFrames; });
 
     for (std::size_t o = 0; o < fingers.size(); ++o) {
-        if (observationTaken_[o] || tracks_.size() >= static_cast<std::size_t>(options_.maxTracks))
+        // Without a height nothing says whether a new finger touches: it waits for one.
+        if (observationTaken_[o] || !fingers[o].heightKnown ||
+            tracks_.size() >= static_cast<std::size_t>(options_.maxTracks))
             continue;
         Track& track = tracks_.emplace_back();
         track.id = nextId_;
@@ -177,13 +181,40 @@ void ContactTracker::assign(std::int64_t timestampUs, const std::vector<FingerOb
 void ContactTracker::observe(Track& track, std::int64_t timestampUs, const FingerObservation& finger,
                              double touchHeightMm, const OneEuroParameters& filter) {
     track.palm = track.palm || finger.palm;
-    updateTouch(track, finger, touchHeightMm);
+    if (!plausibleHeight(track, timestampUs, finger)) {
+        track.missedFrames = 0;
+        if (++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) {
+            track.touching = false;
+            track.pending = false;
+        }
+        // Only a touching finger lies on the table, where an observation without a height places it.
+        if (!track.touching)
+            return;
+    } else {
+        track.unmeasuredFrames = 0;
+        updateTouch(track, finger, touchHeightMm);
+        track.heightMm = finger.padHeightMm;
+        track.heightSeenUs = timestampUs;
+    }
     const double sinceSeenS = static_cast<double>(timestampUs - track.seenUs) * 1e-6;
     track.filter.filter(finger.display, sinceSeenS, filter);
     track.observed = finger.display;
     track.seenUs = timestampUs;
     track.missedFrames = 0;
-    track.heightMm = finger.padHeightMm;
+}
+
+bool ContactTracker::plausibleHeight(const Track& track, std::int64_t timestampUs,
+                                     const FingerObservation& finger) const {
+    if (!finger.heightKnown)
+        return false;
+    if (track.heightSeenUs == kNever)
+        return true;
+    // No finger rises or falls faster than it travels across the table: a height further from the last one
+    // than that allows (and its uncertainty) is a false reading, such as a correlation peak of chance.
+    const double sinceS = static_cast<double>(timestampUs - track.heightSeenUs) * 1e-6;
+    const double reachMm =
+        options_.maxSpeedMmPerS * sinceS + options_.hysteresisSigmas * finger.heightUncertaintyMm;
+    return std::abs(finger.padHeightMm - track.heightMm) <= reachMm;
 }
 
 void ContactTracker::updateTouch(Track& track, const FingerObservation& finger, double touchHeightMm) const {

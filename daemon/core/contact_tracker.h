@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -22,6 +23,9 @@ struct FingerObservation {
     double padHeightMm = 0.0;                           // estimated height of the finger pad above the table
     double heightUncertaintyMm = 0.0;  // one standard deviation of that estimate (large before evidence)
     bool palm = false;                 // a palm, fist or forearm resting: reported as a palm, never a touch
+    // False when the fingertip was found but the code on it was not seen well enough for a height: the
+    // observation keeps its track, and `display` is the point on the table (padHeightMm is not used).
+    bool heightKnown = true;
 };
 
 struct TrackerOptions {
@@ -31,6 +35,11 @@ struct TrackerOptions {
     // Frames a track lives on without an observation, holding its touch: a detection that misses a finger in
     // a frame or two must not end a touch. A finger that really vanishes is released this many frames late.
     int maxMissedFrames = 2;
+    // Frames running a touching finger may show no height before it lifts: the fingertip is found while the
+    // code on it is too faint to measure (a darker finger, a slide), or the height read is one no finger
+    // reaches in the time (maxSpeedMmPerS). As for a missed frame, a finger that really rose is released
+    // this many frames late; the track and its id stay.
+    int maxUnmeasuredFrames = 2;
     // One standard deviation of a resting fingertip's detected contact point, mm. It widens the travel gate
     // and tells the position filter which speeds are jitter.
     double positionNoiseMm = 0.5;
@@ -76,6 +85,10 @@ struct TrackerOptions {
 //   width of each other can swap when each moves more than half their gap a frame (0.6 m/s at 10 mm).
 // - Touch, with T the touch height and sigma the frame's height uncertainty: a finger goes down when its pad
 //   height h <= T, and lifts when h > T + max(minHysteresisMm, hysteresisSigmas * sigma).
+// - Heights: an observation without a height, or with one further from the track's last than a finger moves
+//   at maxSpeedMmPerS in the time (plus three sigma), keeps its track but changes no touch state; after
+//   maxUnmeasuredFrames such frames running a touching finger lifts. It moves only a touching track (its
+//   point lies on the table) and starts no track.
 // - Debouncing: a change needs its condition in two observed frames running, or in one frame when the height
 //   is past the threshold by max(minHysteresisMm, decisiveSigmas * sigma). So a touch-down or lift is
 //   reported in the first frame that meets its condition when the evidence is decisive, and otherwise in the
@@ -111,12 +124,15 @@ public:
     const TrackerOptions& options() const { return options_; }
 
 private:
+    static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
     struct Track {
         std::uint32_t id = 0;
         Eigen::Vector2d observed = Eigen::Vector2d::Zero();  // last observation, display pixels
         std::int64_t seenUs = 0;                             // when it was last observed
         int missedFrames = 0;                                // frames since then
-        double heightMm = 0.0;                               // last observed pad height
+        int unmeasuredFrames = 0;                            // observed frames running without a height
+        double heightMm = 0.0;                               // last plausible pad height
+        std::int64_t heightSeenUs = kNever;                  // when it was measured
         bool touching = false;
         bool palm = false;
         bool pending = false;  // the last observation met the condition for the other touch state, undecided
@@ -130,6 +146,7 @@ private:
     void observe(Track& track, std::int64_t timestampUs, const FingerObservation& finger,
                  double touchHeightMm, const OneEuroParameters& filter);
     void updateTouch(Track& track, const FingerObservation& finger, double touchHeightMm) const;
+    bool plausibleHeight(const Track& track, std::int64_t timestampUs, const FingerObservation& finger) const;
 
     TrackerOptions options_;
     std::vector<Track> tracks_;  // oldest first

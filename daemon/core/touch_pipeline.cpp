@@ -147,17 +147,22 @@ void TouchPipeline::measureFingertips(const PipelineSettings& settings) {
         FingertipObservation& observation = result_.fingertips.emplace_back();
         observation.fingertip = tip;
         observation.visible = height_.estimate(memory.evidence);
-        if (!observation.visible.valid)
-            continue;  // the code on it is not seen well enough: no height, no contact this frame
-        observation.padHeightMm = std::max(0.0, observation.visible.heightMm - options_.visibleAbovePadMm);
+        // Without a height (the code on it not seen well enough) the pad is placed on the table: the
+        // tracker uses it only for a finger that touches.
+        if (observation.visible.valid)
+            observation.padHeightMm =
+                std::max(0.0, observation.visible.heightMm - options_.visibleAbovePadMm);
         // The contact point: the pad, seen through the plane of its height.
         const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
             applyHomography(calibration.cameraToDisplayHomography(observation.padHeightMm), undistorted);
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
+        finger.heightKnown = observation.visible.valid;
         finger.padHeightMm = observation.padHeightMm;
-        finger.heightUncertaintyMm = std::hypot(observation.visible.uncertaintyMm, options_.visibleSpreadMm);
+        if (finger.heightKnown)
+            finger.heightUncertaintyMm =
+                std::hypot(observation.visible.uncertaintyMm, options_.visibleSpreadMm);
     }
     std::swap(remembered_, rememberedNext_);
     rememberedCount_ = next;

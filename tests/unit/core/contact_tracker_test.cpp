@@ -116,6 +116,8 @@ TEST(TrackerOptions, DefaultsAreValidAndMistakesAreNamed) {
     using ::testing::StartsWith;
     EXPECT_THAT(problem([](TrackerOptions& o) { o.maxSpeedMmPerS = 0; }), StartsWith("maxSpeedMmPerS:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.maxMissedFrames = -1; }), StartsWith("maxMissedFrames:"));
+    EXPECT_THAT(problem([](TrackerOptions& o) { o.maxUnmeasuredFrames = -1; }),
+                StartsWith("maxUnmeasuredFrames:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.positionNoiseMm = NAN; }), StartsWith("positionNoiseMm:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.minHysteresisMm = 0; }), StartsWith("minHysteresisMm:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.hysteresisSigmas = -1; }), StartsWith("hysteresisSigmas:"));
@@ -208,6 +210,42 @@ TEST(ContactTracker, AMissedDetectionDoesNotEndATouch) {
     feed({});
     feed({});
     EXPECT_EQ(feed({}).size(), 0u);
+}
+
+FingerObservation unmeasured(const Eigen::Vector2d& mm) {
+    FingerObservation observation = finger(mm, 0.0);
+    observation.heightKnown = false;
+    return observation;
+}
+
+TEST(ContactTracker, AFingertipWithoutAHeightKeepsItsTouchForAFewFramesThenLifts) {
+    Feed feed;
+    feed({finger({60, 40}, 0)});
+    ASSERT_TRUE(feed.contacts()[0].touching);
+    const std::uint32_t id = feed.contacts()[0].id;
+    // Found, but the code on it too faint for a height: it slides on, touching, for maxUnmeasuredFrames.
+    for (int f = 1; f <= 2; ++f) {
+        ASSERT_EQ(feed({unmeasured({60.0 + 5 * f, 40})}).size(), 1u);
+        EXPECT_EQ(feed.contacts()[0].id, id);
+        EXPECT_TRUE(feed.contacts()[0].touching) << "frame " << f;
+        EXPECT_GT(millimetres(feed.contacts()[0]).x(), 60.0 + 5 * f - 5) << "it follows the finger";
+    }
+    // One more and it lifts, but the finger keeps its contact and id.
+    ASSERT_EQ(feed({unmeasured({75, 40})}).size(), 1u);
+    EXPECT_EQ(feed.contacts()[0].id, id);
+    EXPECT_FALSE(feed.contacts()[0].touching);
+    // Measured on the table again: a touch again, of the same finger.
+    feed({finger({76, 40}, 0)});
+    feed({finger({77, 40}, 0)});
+    EXPECT_EQ(feed.contacts()[0].id, id);
+    EXPECT_TRUE(feed.contacts()[0].touching);
+}
+
+TEST(ContactTracker, AFingertipWithoutAHeightStartsNoContact) {
+    Feed feed;
+    EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
+    EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
+    EXPECT_EQ(feed({finger({60, 40}, 20)}).size(), 1u);
 }
 
 TEST(ContactTracker, AJumpFasterThanAFingerIsAnotherFinger) {
@@ -426,6 +464,19 @@ TEST(ContactTracker, ALiftNeedsTwoFramesOrDecisiveEvidence) {
     Feed band;
     touchChanges(band, {0, 4.0, 4.4, 3.5, 4.5}, kSigmaMm, &states);
     EXPECT_THAT(states, ::testing::Each(true));
+}
+
+TEST(ContactTracker, AHeightNoFingerReachesInTheTimeIsIgnored) {
+    std::vector<bool> states;
+    // 35 mm within a frame is 4 m/s: a false reading, not a lift (which it would decide at once).
+    Feed feed;
+    touchChanges(feed, {0, 35.0, 0, 0}, kSigmaMm, &states);
+    EXPECT_THAT(states, ::testing::Each(true));
+    // A finger rising at 1.2 m/s lifts.
+    states.clear();
+    Feed rising;
+    touchChanges(rising, {0, 10.0, 20.0, 30.0}, kSigmaMm, &states);
+    EXPECT_THAT(states, ::testing::ElementsAre(true, false, false, false));
 }
 
 TEST(ContactTracker, TheTouchHeightIsTakenEachFrame) {
