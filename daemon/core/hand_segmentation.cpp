@@ -516,10 +516,39 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                     }
                 if (kTouchingColourRatio * handDistance < tableDistance &&
                     tableDistance < std::numeric_limits<float>::max()) {
-                    classes[j] = Touching;
+                    classes[j] = Candidate;  // until the size of what grew is known
                     queue_[tail++] = j;
                 }
             }
+    }
+
+    // A fingertip's end is no larger than a finger is wide, squared: more that looks like skin and shows the
+    // table's code is content of the hand's colour lying beside it.
+    const int mostBlocks =
+        static_cast<int>(std::ceil(options_.fingerWidthMm * options_.fingerWidthMm / (blockMm * blockMm)));
+    for (int start = 0; start < rows * cols; ++start) {
+        if (classes[start] != Candidate)
+            continue;
+        int size = 0;
+        head = tail = 0;
+        queue_[tail++] = start;
+        classes[start] = Touching;
+        while (head < tail) {
+            const int i = queue_[head++];
+            component_[size++] = i;
+            const int y = i / cols, x = i % cols;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int ny = y + dy, nx = x + dx;
+                    if (ny < 0 || nx < 0 || ny >= rows || nx >= cols || classes[ny * cols + nx] != Candidate)
+                        continue;
+                    classes[ny * cols + nx] = Touching;
+                    queue_[tail++] = ny * cols + nx;
+                }
+        }
+        if (size > mostBlocks)
+            for (int k = 0; k < size; ++k)
+                classes[component_[k]] = Table;
     }
 }
 
