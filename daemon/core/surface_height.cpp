@@ -41,6 +41,8 @@ std::optional<std::string> HeightOptions::validate() const {
         return "centreBehindWidths: must be in [0, 3] finger widths";
     if (!(significance > 0.0) || !std::isfinite(significance))
         return "significance: must be a positive number of standard deviations";
+    if (!(distinctness >= 0.0) || !std::isfinite(distinctness))
+        return "distinctness: must be a number of standard deviations, not negative";
     return std::nullopt;
 }
 
@@ -203,6 +205,26 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     // for another reason (a region reaching onto the hand further up), and nothing says how high. The
     // bottom of the range is the table, below which nothing lies.
     if (best + 1 == count)
+        return result;
+    // Another peak about as high makes the height ambiguous: the faint code on a small region of skin can
+    // match itself at a second height by chance. The runner-up is the best correlation beyond where the
+    // curve falls to half the best on either side.
+    // Heights without evidence (a coarse look) are stepped over.
+    const double half = 0.5 * bestCorrelation;
+    const auto withinPeak = [&](std::size_t h) {
+        return evidence.codeVariance[h] <= 0.0 || correlationAt(h) > half;
+    };
+    std::size_t low = best, high = best;
+    while (low > 0 && withinPeak(low))
+        --low;
+    while (high + 1 < count && withinPeak(high))
+        ++high;
+    double runnerUp = -1.0;
+    for (std::size_t h = 0; h < count; ++h)
+        if ((h < low || h > high) && evidence.codeVariance[h] > 0.0)
+            runnerUp = std::max(runnerUp, correlationAt(h));
+    // Two correlations of chance differ by sqrt(2) times one's deviation.
+    if (bestCorrelation - runnerUp < options_.distinctness * std::sqrt(2.0) * chance)
         return result;
     // The peak to a fraction of a step: the parabola through the best height and its neighbours.
     double offset = 0.0;
