@@ -187,8 +187,9 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
             track.touching = false;
             track.pending = false;
         }
-        // Only a touching finger lies on the table, where an observation without a height places it.
-        if (!track.touching)
+        // Only a touching finger lies on the table, where an observation without a height places it; a
+        // height that was no reading placed it nowhere.
+        if (!track.touching || finger.heightKnown)
             return;
     } else {
         track.unmeasuredFrames = 0;

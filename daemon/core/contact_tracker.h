@@ -87,8 +87,8 @@ struct TrackerOptions {
 //   height h <= T, and lifts when h > T + max(minHysteresisMm, hysteresisSigmas * sigma).
 // - Heights: an observation without a height, or with one further from the track's last than a finger moves
 //   at maxSpeedMmPerS in the time (plus three sigma), keeps its track but changes no touch state; after
-//   maxUnmeasuredFrames such frames running a touching finger lifts. It moves only a touching track (its
-//   point lies on the table) and starts no track.
+//   maxUnmeasuredFrames such frames running a touching finger lifts. An observation without a height moves
+//   only a touching track (its point lies on the table) and starts no track; an implausible one moves none.
 // - Debouncing: a change needs its condition in two observed frames running, or in one frame when the height
 //   is past the threshold by max(minHysteresisMm, decisiveSigmas * sigma). So a touch-down or lift is
 //   reported in the first frame that meets its condition when the evidence is decisive, and otherwise in the
