@@ -163,7 +163,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     values_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
-    handDistance_.resize(blockCount);
+    blocksToHand_.resize(blockCount);
     for (int by = reach; by < blocks.height - reach; ++by)
         for (int bx = reach; bx < blocks.width - reach; ++bx)
             displayBlocks_.at<uchar>(by, bx) =
@@ -357,6 +357,28 @@ bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
     return height.valid && height.heightMm < options_.minElevationMm;
 }
 
+int HandSegmenter::floodComponent(int start, uchar from, uchar to) {
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    uchar* classes = blockClass_.ptr<uchar>();
+    int head = 0, tail = 0, size = 0;
+    queue_[tail++] = start;
+    classes[start] = to;
+    while (head < tail) {
+        const int i = queue_[head++];
+        component_[size++] = i;
+        const int y = i / cols, x = i % cols;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int ny = y + dy, nx = x + dx;
+                if (ny < 0 || nx < 0 || ny >= rows || nx >= cols || classes[ny * cols + nx] != from)
+                    continue;
+                classes[ny * cols + nx] = to;
+                queue_[tail++] = ny * cols + nx;
+            }
+    }
+    return size;
+}
+
 void HandSegmenter::keepHandComponents(const cv::Mat& subtraction) {
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     const double blockMm = options_.blockPx / pixelsPerMm_;
@@ -368,26 +390,7 @@ void HandSegmenter::keepHandComponents(const cv::Mat& subtraction) {
     for (int start = 0; start < rows * cols; ++start) {
         if (classes[start] != Candidate)
             continue;
-        // Flood the component (8-connected), remembering its blocks.
-        int head = 0, tail = 0, size = 0;
-        queue_[tail++] = start;
-        classes[start] = Hand;
-        while (head < tail) {
-            const int i = queue_[head++];
-            component_[size++] = i;
-            const int y = i / cols, x = i % cols;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int ny = y + dy, nx = x + dx;
-                    if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
-                        continue;
-                    const int j = ny * cols + nx;
-                    if (classes[j] == Candidate) {
-                        classes[j] = Hand;
-                        queue_[tail++] = j;
-                    }
-                }
-        }
+        const int size = floodComponent(start, Candidate, Hand);
         if (size < minBlocks || liesOnTable(subtraction, size))
             for (int k = 0; k < size; ++k)
                 classes[component_[k]] = Unlit;
@@ -452,8 +455,8 @@ void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
 void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     // The last millimetres of a touching finger lie too close to the table for the code to tell them from
     // it: their blocks show the table's code. They lie within half a finger's width of where the code sees
-    // the finger, and their colour is the skin's: such blocks join the hand when their colour is nearer the
-    // hand's next to them than the table's beyond that reach.
+    // the finger, and their colour is the skin's: such blocks join the hand when their colour is clearly
+    // nearer the hand's next to them than the table's beyond that reach (kTouchingColourRatio).
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     uchar* classes = blockClass_.ptr<uchar>();
     const double blockMm = options_.blockPx / pixelsPerMm_;
@@ -462,11 +465,11 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
 
     // Blocks to the nearest hand block, up to the farthest a table sample lies from the hand.
     constexpr int kFar = std::numeric_limits<int>::max();
-    std::fill(handDistance_.begin(), handDistance_.end(), kFar);
+    std::fill(blocksToHand_.begin(), blocksToHand_.end(), kFar);
     int head = 0, tail = 0;
     for (int i = 0; i < rows * cols; ++i)
         if (isHand(classes[i])) {
-            handDistance_[i] = 0;
+            blocksToHand_[i] = 0;
             queue_[tail++] = i;
         }
     if (tail == 0)
@@ -474,7 +477,7 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     const int handBlocks = tail;
     while (head < tail) {
         const int i = queue_[head++];
-        if (handDistance_[i] >= reach + sampleReach)
+        if (blocksToHand_[i] >= reach + sampleReach)
             continue;
         const int y = i / cols, x = i % cols;
         for (int dy = -1; dy <= 1; ++dy)
@@ -483,8 +486,8 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                 if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
                     continue;
                 const int j = ny * cols + nx;
-                if (handDistance_[j] == kFar && classes[j] != Outside) {
-                    handDistance_[j] = handDistance_[i] + 1;
+                if (blocksToHand_[j] == kFar && classes[j] != Outside) {
+                    blocksToHand_[j] = blocksToHand_[i] + 1;
                     queue_[tail++] = j;
                 }
             }
@@ -501,7 +504,7 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                 if (ny < 0 || nx < 0 || ny >= rows || nx >= cols)
                     continue;
                 const int j = ny * cols + nx;
-                if (classes[j] != Table || handDistance_[j] > reach)
+                if (classes[j] != Table || blocksToHand_[j] > reach)
                     continue;
                 const float* colour = blockFeature(texture, ny, nx);
                 const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
@@ -510,7 +513,7 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                     for (int tx = std::max(nx - sampleReach, 0); tx <= std::min(nx + sampleReach, cols - 1);
                          ++tx) {
                         const int k = ty * cols + tx;
-                        if (classes[k] == Table && handDistance_[k] > reach)
+                        if (classes[k] == Table && blocksToHand_[k] > reach)
                             tableDistance = std::min(
                                 tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
                     }
@@ -529,23 +532,7 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     for (int start = 0; start < rows * cols; ++start) {
         if (classes[start] != Candidate)
             continue;
-        int size = 0;
-        head = tail = 0;
-        queue_[tail++] = start;
-        classes[start] = Touching;
-        while (head < tail) {
-            const int i = queue_[head++];
-            component_[size++] = i;
-            const int y = i / cols, x = i % cols;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int ny = y + dy, nx = x + dx;
-                    if (ny < 0 || nx < 0 || ny >= rows || nx >= cols || classes[ny * cols + nx] != Candidate)
-                        continue;
-                    classes[ny * cols + nx] = Touching;
-                    queue_[tail++] = ny * cols + nx;
-                }
-        }
+        const int size = floodComponent(start, Candidate, Touching);
         if (size > mostBlocks)
             for (int k = 0; k < size; ++k)
                 classes[component_[k]] = Table;

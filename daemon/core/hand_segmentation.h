@@ -91,6 +91,9 @@ private:
     void segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
     void segmentAsPaper(const cv::Mat& texture, cv::Mat& mask);
     void classifyBlocks();
+    // Relabels the 8-connected blocks of class `from` around `start` as `to`; component_ receives them.
+    // Returns their number.
+    int floodComponent(int start, uchar from, uchar to);
     void keepHandComponents(const cv::Mat& subtraction);
     bool liesOnTable(const cv::Mat& subtraction, int size);
     // A block's mean colour as colourFeature makes it, measured on first use in a frame.
@@ -116,7 +119,7 @@ private:
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
-    std::vector<int> handDistance_;  // block grid: blocks to the nearest hand block (8-connected)
+    std::vector<int> blocksToHand_;  // block grid: blocks to the nearest hand block (8-connected)
     MajorityScratch majorityScratch_;
     SurfaceHeight elevation_;
     HeightEvidence elevationEvidence_;

@@ -218,49 +218,52 @@ TEST(Fingertips, TheImageEdgeMakesNoFingertip) {
     expectFound(found, finger, 1);
 }
 
-TEST(Fingertips, TheEdgeOfWhatWasJudgedCutsLikeTheImageEdge) {
-    // A segmentation that judges only the display cuts a forearm at the display's edge (here y = 100): the
-    // corners of that cut are no fingertips, the finger inside the display is.
+// A display judged from y = 100 down, and a hand inside it whose forearm leaves it upwards at `armDegrees`.
+struct ArmLeavingTheDisplay {
     cv::Mat judged = cv::Mat::zeros(488, 648, CV_8UC1);
-    judged(cv::Rect(40, 100, 560, 360)).setTo(255);
     cv::Mat mask = cv::Mat::zeros(488, 648, CV_8UC1);
-    fillCapsule(mask, {{300, 150}, Eigen::Vector2d(300, 150) + 300 * towards(-60), 30});
-    fillEllipse(mask, {300, 170}, 40, 32);
-    const Capsule finger{{300, 170}, {310, 300}, 9};
-    fillCapsule(mask, finger);
-    mask.setTo(0, judged == 0);
+    Capsule finger{{300, 170}, {310, 300}, 9};
+
+    explicit ArmLeavingTheDisplay(double armDegrees) {
+        judged(cv::Rect(40, 100, 560, 360)).setTo(255);
+        fillCapsule(mask, {{300, 150}, Eigen::Vector2d(300, 150) + 300 * towards(armDegrees), 30});
+        fillEllipse(mask, {300, 170}, 40, 32);
+        fillCapsule(mask, finger);
+    }
+};
+
+TEST(Fingertips, TheEdgeOfWhatWasJudgedCutsLikeTheImageEdge) {
+    // A segmentation that judges only the display cuts a forearm at the display's edge: the corners of that
+    // cut are no fingertips, the finger inside the display is.
+    ArmLeavingTheDisplay scene(-60);
+    scene.mask.setTo(0, scene.judged == 0);
     FingertipScratch scratch;
     Fingertips found;
-    findFingertips(mask, drawnOptions(), scratch, found);
+    findFingertips(scene.mask, drawnOptions(), scratch, found);
     EXPECT_GT(found.size(), 1u) << "without the judged region the cut's corners look like fingertips";
-    findFingertips(mask, drawnOptions(), scratch, found, judged);
+    findFingertips(scene.mask, drawnOptions(), scratch, found, scene.judged);
     ASSERT_EQ(found.size(), 1u) << describe(found);
-    expectFound(found, finger, 0);
-    EXPECT_THROW(findFingertips(mask, drawnOptions(), scratch, found, judged(cv::Rect(0, 0, 10, 10))),
-                 std::invalid_argument);
+    expectFound(found, scene.finger, 0);
+    EXPECT_THROW(
+        findFingertips(scene.mask, drawnOptions(), scratch, found, scene.judged(cv::Rect(0, 0, 10, 10))),
+        std::invalid_argument);
 }
 
 TEST(Fingertips, ACornerRoundedOffNearTheJudgedEdgeIsNoFingertip) {
     // The mask's smoothing rounds the corners where the judged region's edge cuts a forearm, and may leave
     // them a few pixels inside that edge: still corners, not fingertips.
-    cv::Mat judged = cv::Mat::zeros(488, 648, CV_8UC1);
-    judged(cv::Rect(40, 100, 560, 360)).setTo(255);
-    cv::Mat mask = cv::Mat::zeros(488, 648, CV_8UC1);
-    fillCapsule(mask, {{300, 150}, Eigen::Vector2d(300, 150) + 300 * towards(-150), 30});
-    fillEllipse(mask, {300, 170}, 40, 32);
-    const Capsule finger{{300, 170}, {310, 300}, 9};
-    fillCapsule(mask, finger);
-    mask(cv::Rect(0, 0, mask.cols, 104)).setTo(0);
-    cv::medianBlur(mask, mask, 11);
+    ArmLeavingTheDisplay scene(-150);
+    scene.mask(cv::Rect(0, 0, scene.mask.cols, 104)).setTo(0);
+    cv::medianBlur(scene.mask, scene.mask, 11);
     FingertipScratch scratch;
     Fingertips found;
     FingertipOptions onTheEdgeOnly = drawnOptions();
     onTheEdgeOnly.edgeMarginWidths = 0.0;
-    findFingertips(mask, onTheEdgeOnly, scratch, found, judged);
+    findFingertips(scene.mask, onTheEdgeOnly, scratch, found, scene.judged);
     EXPECT_GT(found.size(), 1u) << "the rounded corners off the edge look like fingertips";
-    findFingertips(mask, drawnOptions(), scratch, found, judged);
+    findFingertips(scene.mask, drawnOptions(), scratch, found, scene.judged);
     ASSERT_EQ(found.size(), 1u) << describe(found);
-    expectFound(found, finger, 0);
+    expectFound(found, scene.finger, 0);
 }
 
 TEST(Fingertips, AllocateNothingOnceWarm) {
