@@ -26,6 +26,35 @@ float sample(const cv::Mat& image, float x, float y) {
     return (row0[0] * (1 - fx) + row0[1] * fx) * (1 - fy) + (row1[0] * (1 - fx) + row1[1] * fx) * fy;
 }
 
+// What the code and a move leave at one pixel of a pair, summed over the channels: the difference of the
+// two frames, and the gradient of their sum (the texture's, twice).
+template <int Channels>
+float difference(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
+    const uchar* p = plus.ptr<uchar>(y) + Channels * x;
+    const uchar* m = minus.ptr<uchar>(y) + Channels * x;
+    int sum = 0;
+    for (int c = 0; c < Channels; ++c)
+        sum += p[c] - m[c];
+    return static_cast<float>(sum);
+}
+
+template <int Channels>
+float brightness(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
+    const uchar* p = plus.ptr<uchar>(y) + Channels * x;
+    const uchar* m = minus.ptr<uchar>(y) + Channels * x;
+    int sum = 0;
+    for (int c = 0; c < Channels; ++c)
+        sum += p[c] + m[c];
+    return static_cast<float>(sum);
+}
+
+template <int Channels>
+cv::Point2f gradient(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
+    return {
+        0.5f * (brightness<Channels>(plus, minus, x + 1, y) - brightness<Channels>(plus, minus, x - 1, y)),
+        0.5f * (brightness<Channels>(plus, minus, x, y + 1) - brightness<Channels>(plus, minus, x, y - 1))};
+}
+
 }  // namespace
 
 std::optional<std::string> HeightOptions::validate() const {
@@ -98,6 +127,8 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     constexpr std::size_t kTypicalMostPixels = 8192;
     values_.reserve(kTypicalMostPixels);
     points_.reserve(kTypicalMostPixels);
+    gradients_.reserve(kTypicalMostPixels);
+    residuals_.reserve(kTypicalMostPixels);
 
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     undistorted_.create(calibration.cameraSize, CV_32FC2);
@@ -112,6 +143,7 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
 void SurfaceHeight::clearPixels() {
     values_.clear();
     points_.clear();
+    gradients_.clear();
 }
 
 void SurfaceHeight::addPixel(const cv::Mat& subtraction, int x, int y) {
@@ -120,16 +152,20 @@ void SurfaceHeight::addPixel(const cv::Mat& subtraction, int x, int y) {
     points_.emplace_back(u[0], u[1]);
 }
 
-void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask,
+void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handMask,
                                      const Eigen::Vector2d& tip, const Eigen::Vector2d& direction,
                                      double widthPx, HeightEvidence& evidence) {
-    CV_Assert(subtraction.type() == CV_16SC1 && handMask.type() == CV_8UC1);
+    const cv::Mat& plus = pair.positive.image;
+    const cv::Mat& minus = pair.negative.image;
+    CV_Assert((plus.type() == CV_8UC1 || plus.type() == CV_8UC3) && minus.type() == plus.type() &&
+              minus.size() == plus.size() && handMask.type() == CV_8UC1 && handMask.size() == plus.size());
+    const bool colour = plus.channels() == 3;
     const Eigen::Vector2d centre = tip - options_.centreBehindWidths * widthPx * direction;
     const double radius = options_.regionWidths * widthPx;
     const int x0 = std::max(1, static_cast<int>(std::floor(centre.x() - radius)));
-    const int x1 = std::min(subtraction.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));
+    const int x1 = std::min(plus.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));
     const int y0 = std::max(1, static_cast<int>(std::floor(centre.y() - radius)));
-    const int y1 = std::min(subtraction.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
+    const int y1 = std::min(plus.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
     clearPixels();
     for (int y = y0; y <= y1; ++y) {
         const uchar* above = handMask.ptr<uchar>(y - 1);
@@ -141,24 +177,26 @@ void SurfaceHeight::measureFingertip(const cv::Mat& subtraction, const cv::Mat& 
             if (!m[x] || !above[x] || !below[x] || !m[x - 1] || !m[x + 1] ||
                 (x - centre.x()) * (x - centre.x()) + (y - centre.y()) * (y - centre.y()) > radius * radius)
                 continue;
-            addPixel(subtraction, x, y);
+            values_.push_back(colour ? difference<3>(plus, minus, x, y) : difference<1>(plus, minus, x, y));
+            const cv::Vec2f& u = undistorted_.at<cv::Vec2f>(y, x);
+            points_.emplace_back(u[0], u[1]);
+            if (options_.explainMotion)
+                gradients_.push_back(colour ? gradient<3>(plus, minus, x, y)
+                                            : gradient<1>(plus, minus, x, y));
         }
     }
     measurePixels(evidence);
 }
 
-void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) const {
+void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) {
     evidence.clear(homographies_.size());
     const std::size_t n = values_.size();
     if (n < 8)
         return;
-    double sum = 0.0;
-    for (float v : values_)
-        sum += v;
-    const double meanS = sum / static_cast<double>(n);
+    explainS();
     double varianceS = 0.0;
-    for (float v : values_)
-        varianceS += (v - meanS) * (v - meanS);
+    for (float r : residuals_)
+        varianceS += r * r;
     evidence.subtractionVariance = varianceS;
     evidence.pixels = static_cast<double>(n);
     for (std::size_t h = 0; h < homographies_.size(); h += stride) {
@@ -172,11 +210,37 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
                 std::max(0.0f, sample(panel_, static_cast<float>(px / pw), static_cast<float>(py / pw)));
             sumP += p;
             sumPP += p * p;
-            sumSP += (values_[i] - meanS) * p;
+            sumSP += residuals_[i] * p;
         }
         evidence.covariance[h] = sumSP;
         evidence.codeVariance[h] = std::max(0.0, sumPP - sumP * sumP / static_cast<double>(n));
     }
+}
+
+void SurfaceHeight::explainS() {
+    const std::size_t n = values_.size();
+    residuals_.resize(n);
+    // Least squares of S on (1, Tx, Ty) when the gradients were gathered, on 1 alone otherwise.
+    const bool withGradients = gradients_.size() == n;
+    const auto regressor = [&](std::size_t i) {
+        return withGradients ? Eigen::Vector3d(1.0, gradients_[i].x, gradients_[i].y)
+                             : Eigen::Vector3d(1.0, 0.0, 0.0);
+    };
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d r = regressor(i);
+        normal.noalias() += r * r.transpose();
+        moment += r * static_cast<double>(values_[i]);
+    }
+    // A region of flat texture has no gradient to fit: a slight ridge keeps the system solvable and leaves
+    // those coefficients at zero.
+    const double ridge = 1e-6 * static_cast<double>(n) + 1e-9;
+    normal(1, 1) += ridge;
+    normal(2, 2) += ridge;
+    const Eigen::Vector3d fit = normal.ldlt().solve(moment);
+    for (std::size_t i = 0; i < n; ++i)
+        residuals_[i] = static_cast<float>(values_[i] - regressor(i).dot(fit));
 }
 
 HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {

@@ -8,6 +8,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "core/calibration.h"
+#include "core/frame.h"
 
 namespace everytouch::core {
 
@@ -35,6 +36,12 @@ struct HeightOptions {
     // frames and missed 1 to 3 of 13 taps, two missed none and still removed nearly all false touches
     // (docs/detection.md).
     double distinctness = 2.0;
+    // A finger that moves between the two frames of a pair leaves its own shading in their difference along
+    // its outline and creases, often far stronger than the faint code on skin. Over a fingertip such a move
+    // is a translation, so what it leaves is the texture's gradient times the move: the difference is first
+    // cleared of what the gradient explains, then correlated with the code. On the drag scenario this reads
+    // a sliding fingertip's height in 0.53 of its frames instead of 0.15 (surface_height_rendered_test).
+    bool explainMotion = true;
 
     std::optional<std::string> validate() const;
 };
@@ -72,9 +79,12 @@ public:
     std::size_t heights() const { return homographies_.size(); }
     double heightOf(std::size_t candidate) const { return candidate * options_.stepMm; }
 
-    // Gathers the evidence of one frame around a fingertip (camera pixels, raw) of `widthPx` whose finger
-    // points along `direction`: subtraction S (CV_16SC1), hand mask (CV_8UC1). No allocation once sized.
-    void measureFingertip(const cv::Mat& subtraction, const cv::Mat& handMask, const Eigen::Vector2d& tip,
+    // Gathers the evidence of one frame pair around a fingertip (camera pixels, raw) of `widthPx` whose
+    // finger points along `direction`; handMask: CV_8UC1. The code is read from the frames' difference summed
+    // over their channels, not from S (the largest channel's): on skin every channel carries it, and what a
+    // move leaves in the sum is linear in the texture's gradient, which explainMotion removes. No allocation
+    // once sized.
+    void measureFingertip(const FramePair& pair, const cv::Mat& handMask, const Eigen::Vector2d& tip,
                           const Eigen::Vector2d& direction, double widthPx, HeightEvidence& evidence);
 
     // The evidence of the pixels added since clear(): for any surface, e.g. a region that might be a hand.
@@ -83,18 +93,23 @@ public:
     std::size_t pixelCount() const { return values_.size(); }
     // Every `stride`-th candidate height only (the others get no evidence): a coarse look is enough to tell
     // the table from something well above it.
-    void measurePixels(HeightEvidence& evidence, std::size_t stride = 1) const;
+    void measurePixels(HeightEvidence& evidence, std::size_t stride = 1);
 
     // The height the evidence supports best.
     HeightEstimate estimate(const HeightEvidence& evidence) const;
 
 private:
+    // residuals_ from values_ (and gradients_ when they were gathered).
+    void explainS();
+
     HeightOptions options_;
     cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
     cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
     std::vector<Eigen::Matrix3d> homographies_;  // undistorted camera -> projector, per candidate height
-    std::vector<float> values_;                  // S at the region's pixels
+    std::vector<float> values_;                  // S (or a pair's difference) at the region's pixels
+    std::vector<cv::Point2f> gradients_;         // the texture's gradient there, when a move is explained
     std::vector<cv::Point2f> points_;            // the region's undistorted pixels
+    std::vector<float> residuals_;               // values_ less what their mean and a move explain
 };
 
 }  // namespace everytouch::core

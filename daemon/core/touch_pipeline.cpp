@@ -113,21 +113,20 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
     findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_,
                    segmenter_.judgedRegion());
-    measureFingertips(settings);
+    measureFingertips(pair, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);
     return result_;
 }
 
-void TouchPipeline::measureFingertips(const PipelineSettings& settings) {
+void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSettings& settings) {
     const Calibration& calibration = *settings.calibration;
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     result_.fingertips.clear();
     observations_.clear();
     int next = 0;
     for (const Fingertip& tip : found_) {
-        height_.measureFingertip(result_.subtraction, result_.handMask, tip.tip, tip.direction, tip.widthPx,
-                                 frameEvidence_);
+        height_.measureFingertip(pair, result_.handMask, tip.tip, tip.direction, tip.widthPx, frameEvidence_);
         // The same fingertip in the last frame: its evidence carries over while it stays put.
         int same = -1;
         double nearest = kSameWidths * tip.widthPx;

@@ -105,7 +105,7 @@ private:
     };
 
     void adoptRig(const PipelineSettings& settings);
-    void measureFingertips(const PipelineSettings& settings);
+    void measureFingertips(const FramePair& pair, const PipelineSettings& settings);
 
     DetectionOptions options_;
     HandSegmenter segmenter_;

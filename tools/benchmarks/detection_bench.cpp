@@ -159,7 +159,7 @@ void BM_HeightOfOneFingertip(benchmark::State& state) {
     for (auto _ : state) {
         const auto start = Clock::now();
         const core::Fingertip& tip = fingertips.front();
-        height.measureFingertip(subtraction, mask, tip.tip, tip.direction, tip.widthPx, evidence);
+        height.measureFingertip(scene.pairs.front(), mask, tip.tip, tip.direction, tip.widthPx, evidence);
         benchmark::DoNotOptimize(height.estimate(evidence));
         timings.add(Clock::now() - start);
     }
