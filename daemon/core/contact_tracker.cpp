@@ -183,7 +183,9 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
     track.palm = track.palm || finger.palm;
     if (!plausibleHeight(track, timestampUs, finger)) {
         track.missedFrames = 0;
-        if (++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) {
+        // A touching finger whose code still favours the table was not seen to rise.
+        const bool stillDown = track.touching && !finger.heightKnown && finger.codeFavoursTable;
+        if (!stillDown && ++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) {
             track.touching = false;
             track.pending = false;
         }

@@ -26,6 +26,10 @@ struct FingerObservation {
     // False when the fingertip was found but the code on it was not seen well enough for a height: the
     // observation keeps its track, and `display` is the point on the table (padHeightMm is not used).
     bool heightKnown = true;
+    // Without a height: the code on the fingertip still matches the heights a touching fingertip shows
+    // better than any higher one (SurfaceHeight::favoursUpTo). A touching finger stays down through such
+    // frames: they do not count towards maxUnmeasuredFrames.
+    bool codeFavoursTable = false;
 };
 
 struct TrackerOptions {
@@ -87,8 +91,9 @@ struct TrackerOptions {
 //   height h <= T, and lifts when h > T + max(minHysteresisMm, hysteresisSigmas * sigma).
 // - Heights: an observation without a height, or with one further from the track's last than a finger moves
 //   at maxSpeedMmPerS in the time (plus three sigma), keeps its track but changes no touch state; after
-//   maxUnmeasuredFrames such frames running a touching finger lifts. An observation without a height moves
-//   only a touching track (its point lies on the table) and starts no track; an implausible one moves none.
+//   maxUnmeasuredFrames such frames running a touching finger lifts, not counting frames whose code still
+//   favours the table. An observation without a height moves only a touching track (its point lies on the
+//   table) and starts no track; an implausible one moves none.
 // - Debouncing: a change needs its condition in two observed frames running, or in one frame when the height
 //   is past the threshold by max(minHysteresisMm, decisiveSigmas * sigma). So a touch-down or lift is
 //   reported in the first frame that meets its condition when the evidence is decisive, and otherwise in the

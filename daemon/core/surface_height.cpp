@@ -243,6 +243,21 @@ void SurfaceHeight::explainS() {
         residuals_[i] = static_cast<float>(values_[i] - regressor(i).dot(fit));
 }
 
+bool SurfaceHeight::favoursUpTo(const HeightEvidence& evidence, double heightMm) const {
+    if (evidence.covariance.empty() || evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)
+        return false;
+    double below = -2.0, above = -2.0;
+    for (std::size_t h = 0; h < evidence.covariance.size(); ++h) {
+        if (evidence.codeVariance[h] <= 0.0)
+            continue;
+        const double r =
+            evidence.covariance[h] / std::sqrt(evidence.codeVariance[h] * evidence.subtractionVariance);
+        double& side = heightOf(h) <= heightMm ? below : above;
+        side = std::max(side, r);
+    }
+    return below > above && below >= options_.significance * std::sqrt(2.0 / evidence.pixels);
+}
+
 HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     HeightEstimate result;
     const std::size_t count = evidence.covariance.size();

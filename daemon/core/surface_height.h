@@ -97,6 +97,9 @@ public:
 
     // The height the evidence supports best.
     HeightEstimate estimate(const HeightEvidence& evidence) const;
+    // Whether evidence that gives no height (its peak not distinct, or at the top of the range) still leans:
+    // its best match among the heights up to `heightMm` is significant and beats every height above.
+    bool favoursUpTo(const HeightEvidence& evidence, double heightMm) const;
 
 private:
     // residuals_ from values_ (and gradients_ when they were gathered).

@@ -158,6 +158,11 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
         finger.heightKnown = observation.visible.valid;
+        // This frame's evidence alone: a finger rising from the table stays put in the image, and its
+        // earlier frames' evidence would hold it down.
+        if (!finger.heightKnown)
+            finger.codeFavoursTable =
+                height_.favoursUpTo(frameEvidence_, settings.touchHeightMm + options_.visibleAbovePadMm);
         finger.padHeightMm = observation.padHeightMm;
         if (finger.heightKnown)
             finger.heightUncertaintyMm =

@@ -241,6 +241,24 @@ TEST(ContactTracker, AFingertipWithoutAHeightKeepsItsTouchForAFewFramesThenLifts
     EXPECT_TRUE(feed.contacts()[0].touching);
 }
 
+TEST(ContactTracker, AFingertipWhoseCodeFavoursTheTableStaysDownWithoutAHeight) {
+    Feed feed;
+    feed({finger({60, 40}, 0)});
+    ASSERT_TRUE(feed.contacts()[0].touching);
+    // A slide whose code is too faint for a height but still matches the table better than anything higher:
+    // it does not count towards the frames that lift a touch.
+    for (int f = 1; f <= 6; ++f) {
+        FingerObservation sliding = unmeasured({60.0 + 2 * f, 40});
+        sliding.codeFavoursTable = true;
+        ASSERT_EQ(feed({sliding}).size(), 1u);
+        EXPECT_TRUE(feed.contacts()[0].touching) << "frame " << f;
+    }
+    // Without that lean, three such frames lift it.
+    for (int f = 1; f <= 3; ++f)
+        feed({unmeasured({72.0 + 2 * f, 40})});
+    EXPECT_FALSE(feed.contacts()[0].touching);
+}
+
 TEST(ContactTracker, AFingertipWithoutAHeightStartsNoContact) {
     Feed feed;
     EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
