@@ -119,9 +119,17 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     pattern.convertTo(panel_, CV_32FC1);
     cv::GaussianBlur(panel_, panel_, cv::Size(), sigma);
 
-    homographies_.clear();
-    for (double d = 0.0; d <= options_.maxHeightMm + 1e-9; d += options_.stepMm)
-        homographies_.push_back(calibration.cameraToProjectorHomography(d));
+    heightCount_ = static_cast<std::size_t>(std::floor(options_.maxHeightMm / options_.stepMm + 1e-9)) + 1;
+    // The camera's rays in table coordinates and the projector's view of them: a pixel's ray meets the plane
+    // at height d in a point the projector sees at a + d b (homogeneous), a and b from the ray alone.
+    const Eigen::Matrix3d cameraToTableRotation = calibration.tableToCamera.rotation().transpose();
+    rayFromPixel_ = cameraToTableRotation * calibration.cameraMatrix.inverse();
+    cameraCentre_ = -(cameraToTableRotation * calibration.tableToCamera.translation());
+    projectorRotation_ = calibration.projectorMatrix * calibration.tableToProjector.rotation();
+    epipole_ = calibration.projectorMatrix * (calibration.tableToProjector * cameraCentre_);
+    sumP_.assign(heightCount_, 0.0);
+    sumPP_.assign(heightCount_, 0.0);
+    sumSP_.assign(heightCount_, 0.0);
 
     // Regions are a fingertip or a sample of a hand: this many pixels at most, in practice.
     constexpr std::size_t kTypicalMostPixels = 8192;
@@ -189,7 +197,7 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
 }
 
 void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) {
-    evidence.clear(homographies_.size());
+    evidence.clear(heightCount_);
     const std::size_t n = values_.size();
     if (n < 8)
         return;
@@ -199,21 +207,29 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
         varianceS += r * r;
     evidence.subtractionVariance = varianceS;
     evidence.pixels = static_cast<double>(n);
-    for (std::size_t h = 0; h < homographies_.size(); h += stride) {
-        const Eigen::Matrix3d& H = homographies_[h];
-        double sumP = 0.0, sumPP = 0.0, sumSP = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double px = H(0, 0) * points_[i].x + H(0, 1) * points_[i].y + H(0, 2);
-            const double py = H(1, 0) * points_[i].x + H(1, 1) * points_[i].y + H(1, 2);
-            const double pw = H(2, 0) * points_[i].x + H(2, 1) * points_[i].y + H(2, 2);
-            const float p =
-                std::max(0.0f, sample(panel_, static_cast<float>(px / pw), static_cast<float>(py / pw)));
-            sumP += p;
-            sumPP += p * p;
-            sumSP += residuals_[i] * p;
+    std::fill(sumP_.begin(), sumP_.end(), 0.0);
+    std::fill(sumPP_.begin(), sumPP_.end(), 0.0);
+    std::fill(sumSP_.begin(), sumSP_.end(), 0.0);
+    const double dStep = static_cast<double>(stride) * options_.stepMm;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(points_[i].x, points_[i].y, 1.0);
+        if (std::abs(ray.z()) < 1e-12)
+            continue;  // parallel to the table: no pixel of a fingertip
+        const Eigen::Vector3d along = projectorRotation_ * ray / ray.z();
+        Eigen::Vector3d p = epipole_ - cameraCentre_.z() * along;  // on the table
+        const Eigen::Vector3d step = dStep * along;
+        const double residual = residuals_[i];
+        for (std::size_t h = 0; h < heightCount_; h += stride, p += step) {
+            const float value = std::max(
+                0.0f, sample(panel_, static_cast<float>(p.x() / p.z()), static_cast<float>(p.y() / p.z())));
+            sumP_[h] += value;
+            sumPP_[h] += value * value;
+            sumSP_[h] += residual * value;
         }
-        evidence.covariance[h] = sumSP;
-        evidence.codeVariance[h] = std::max(0.0, sumPP - sumP * sumP / static_cast<double>(n));
+    }
+    for (std::size_t h = 0; h < heightCount_; h += stride) {
+        evidence.covariance[h] = sumSP_[h];
+        evidence.codeVariance[h] = std::max(0.0, sumPP_[h] - sumP_[h] * sumP_[h] / static_cast<double>(n));
     }
 }
 

@@ -76,7 +76,7 @@ public:
     // pattern: CV_8UC1 0/1, projector size.
     void setRig(const Calibration& calibration, const cv::Mat& pattern);
 
-    std::size_t heights() const { return homographies_.size(); }
+    std::size_t heights() const { return heightCount_; }
     double heightOf(std::size_t candidate) const { return candidate * options_.stepMm; }
 
     // Gathers the evidence of one frame pair around a fingertip (camera pixels, raw) of `widthPx` whose
@@ -108,11 +108,19 @@ private:
     HeightOptions options_;
     cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
     cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
-    std::vector<Eigen::Matrix3d> homographies_;  // undistorted camera -> projector, per candidate height
-    std::vector<float> values_;                  // S (or a pair's difference) at the region's pixels
-    std::vector<cv::Point2f> gradients_;         // the texture's gradient there, when a move is explained
-    std::vector<cv::Point2f> points_;            // the region's undistorted pixels
-    std::vector<float> residuals_;               // values_ less what their mean and a move explain
+    std::size_t heightCount_ = 0;
+    // The geometry of the candidate planes: undistorted pixel -> ray (table frame), the camera's centre
+    // (table frame), the projector's intrinsics times rotation, and the projector's image of the camera's
+    // centre (homogeneous).
+    Eigen::Matrix3d rayFromPixel_ = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d cameraCentre_ = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d projectorRotation_ = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d epipole_ = Eigen::Vector3d::Zero();
+    std::vector<double> sumP_, sumPP_, sumSP_;  // per candidate height, while measuring
+    std::vector<float> values_;                 // S (or a pair's difference) at the region's pixels
+    std::vector<cv::Point2f> gradients_;        // the texture's gradient there, when a move is explained
+    std::vector<cv::Point2f> points_;           // the region's undistorted pixels
+    std::vector<float> residuals_;              // values_ less what their mean and a move explain
 };
 
 }  // namespace everytouch::core

@@ -1,8 +1,10 @@
-// The height of a fingertip's visible surface on rendered frame pairs: a finger that slides on the table.
+// The height of a surface on the simulated rig: the code carried through each candidate plane, and a finger
+// that slides on the table in rendered frame pairs.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "core/camera_model.h"
 #include "core/code_image.h"
 #include "core/fingertips.h"
 #include "core/geometry.h"
@@ -80,6 +82,41 @@ SlideScore scoreSlidingFingertips(const HeightOptions& heightOptions, double tol
         score.read += estimate.valid && std::abs(estimate.heightMm - trueHeight) <= toleranceMm;
     }
     return score;
+}
+
+TEST(SurfaceHeightRendered, TheCodeThroughAPlaneGivesThatPlanesHeight) {
+    // S over a patch at the image's centre as the code would be seen on a surface at each height: the
+    // pattern sampled through the calibration's homography of that plane.
+    sim::SimParameters parameters;
+    const cv::Mat pattern = sim::rigPattern(parameters);
+    sim::Simulator simulator(parameters, pattern);
+    const Calibration& calibration = simulator.calibration();
+    SurfaceHeight height{HeightOptions{}};
+    height.setRig(calibration, pattern);
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    cv::Mat subtraction(calibration.cameraSize, CV_16SC1, cv::Scalar(0));
+    const cv::Rect patch(calibration.cameraSize.width / 2 - 20, calibration.cameraSize.height / 2 - 20, 40,
+                         40);
+    HeightEvidence evidence;
+    for (const double trueMm : {0.0, 7.0, 13.0, 24.0, 40.0}) {
+        const Eigen::Matrix3d toProjector = calibration.cameraToProjectorHomography(trueMm);
+        height.clearPixels();
+        for (int y = patch.y; y < patch.y + patch.height; ++y)
+            for (int x = patch.x; x < patch.x + patch.width; ++x) {
+                const Eigen::Vector2d p =
+                    applyHomography(toProjector, camera.undistortPixel(Eigen::Vector2d(x, y)));
+                const int px = static_cast<int>(std::lround(p.x())),
+                          py = static_cast<int>(std::lround(p.y()));
+                const bool lit =
+                    px >= 0 && py >= 0 && px < pattern.cols && py < pattern.rows && pattern.at<uchar>(py, px);
+                subtraction.at<short>(y, x) = lit ? 40 : 0;
+                height.addPixel(subtraction, x, y);
+            }
+        height.measurePixels(evidence);
+        const HeightEstimate estimate = height.estimate(evidence);
+        ASSERT_TRUE(estimate.valid) << "at " << trueMm << " mm";
+        EXPECT_NEAR(estimate.heightMm, trueMm, 1.0) << "one candidate step";
+    }
 }
 
 TEST(SurfaceHeightRendered, ASlidingFingertipsHeightIsRead) {
