@@ -183,9 +183,13 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
     track.palm = track.palm || finger.palm;
     if (!plausibleHeight(track, timestampUs, finger)) {
         track.missedFrames = 0;
-        // A touching finger whose code still favours the table was not seen to rise.
+        // A touching finger whose code still favours the table was not seen to rise; one whose last height
+        // was above the touch height and whose code now shows nothing near the table was seen to leave it.
         const bool stillDown = track.touching && !finger.heightKnown && finger.codeFavoursTable;
-        if (!stillDown && ++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) {
+        const bool leaving = track.touching && !finger.heightKnown && !finger.codeFavoursTable &&
+                             track.unmeasuredFrames == 0 && track.heightMm > touchHeightMm;
+        if ((!stillDown && ++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) ||
+            leaving) {
             track.touching = false;
             track.pending = false;
         }

@@ -92,8 +92,10 @@ struct TrackerOptions {
 // - Heights: an observation without a height, or with one further from the track's last than a finger moves
 //   at maxSpeedMmPerS in the time (plus three sigma), keeps its track but changes no touch state; after
 //   maxUnmeasuredFrames such frames running a touching finger lifts, not counting frames whose code still
-//   favours the table. An observation without a height moves only a touching track (its point lies on the
-//   table) and starts no track; an implausible one moves none.
+//   favours the table. A frame without a height whose code does not favour the table, right after a height
+//   above the touch height, lifts a touching finger at once: it was seen leaving the table, and nothing
+//   puts it back (the two frames running of the debouncing). An observation without a height moves only a
+//   touching track (its point lies on the table) and starts no track; an implausible one moves none.
 // - Debouncing: a change needs its condition in two observed frames running, or in one frame when the height
 //   is past the threshold by max(minHysteresisMm, decisiveSigmas * sigma). So a touch-down or lift is
 //   reported in the first frame that meets its condition when the evidence is decisive, and otherwise in the

@@ -259,6 +259,25 @@ TEST(ContactTracker, AFingertipWhoseCodeFavoursTheTableStaysDownWithoutAHeight) 
     EXPECT_FALSE(feed.contacts()[0].touching);
 }
 
+TEST(ContactTracker, AHeightAboveTheTouchHeightThenNoCodeNearTheTableLiftsAtOnce) {
+    Feed feed;
+    feed({finger({60, 40}, 0)});
+    ASSERT_TRUE(feed.contacts()[0].touching);
+    // Above the touch height but within the band: still touching.
+    feed({finger({60, 40}, kTouchMm + 1.0)});
+    ASSERT_TRUE(feed.contacts()[0].touching);
+    // A lean to the table keeps it down.
+    FingerObservation leaning = unmeasured({60, 40});
+    leaning.codeFavoursTable = true;
+    feed({leaning});
+    EXPECT_TRUE(feed.contacts()[0].touching);
+    // Seen above the touch height again, then no code near the table: it has left.
+    feed({finger({60, 40}, kTouchMm + 1.0)});
+    ASSERT_TRUE(feed.contacts()[0].touching);
+    feed({unmeasured({60, 40})});
+    EXPECT_FALSE(feed.contacts()[0].touching);
+}
+
 TEST(ContactTracker, AFingertipWithoutAHeightStartsNoContact) {
     Feed feed;
     EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
