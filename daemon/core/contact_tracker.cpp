@@ -185,11 +185,13 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
         track.missedFrames = 0;
         // A touching finger whose code still favours the table was not seen to rise; one whose last height
         // was above the touch height and whose code now shows nothing near the table was seen to leave it.
-        const bool stillDown = track.touching && !finger.heightKnown && finger.codeFavoursTable;
-        const bool leaving = track.touching && !finger.heightKnown && !finger.codeFavoursTable &&
+        const bool touchingWithoutHeight = track.touching && !finger.heightKnown;
+        const bool stillDown = touchingWithoutHeight && finger.codeFavoursTable;
+        const bool leaving = touchingWithoutHeight && !finger.codeFavoursTable &&
                              track.unmeasuredFrames == 0 && track.heightMm > touchHeightMm;
-        if ((!stillDown && ++track.unmeasuredFrames > options_.maxUnmeasuredFrames && track.touching) ||
-            leaving) {
+        if (!stillDown)
+            ++track.unmeasuredFrames;
+        if (track.touching && (leaving || track.unmeasuredFrames > options_.maxUnmeasuredFrames)) {
             track.touching = false;
             track.pending = false;
         }

@@ -26,33 +26,22 @@ float sample(const cv::Mat& image, float x, float y) {
     return (row0[0] * (1 - fx) + row0[1] * fx) * (1 - fy) + (row1[0] * (1 - fx) + row1[1] * fx) * fy;
 }
 
-// What the code and a move leave at one pixel of a pair, summed over the channels: the difference of the
-// two frames, and the gradient of their sum (the texture's, twice).
-template <int Channels>
-float difference(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
+// A pixel of a pair summed over its channels: the frames' difference (Sign -1), which carries the code and
+// what a move leaves, or their sum (Sign +1), twice the texture.
+template <int Channels, int Sign>
+float channelSum(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
     const uchar* p = plus.ptr<uchar>(y) + Channels * x;
     const uchar* m = minus.ptr<uchar>(y) + Channels * x;
     int sum = 0;
     for (int c = 0; c < Channels; ++c)
-        sum += p[c] - m[c];
+        sum += p[c] + Sign * m[c];
     return static_cast<float>(sum);
 }
 
 template <int Channels>
-float brightness(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
-    const uchar* p = plus.ptr<uchar>(y) + Channels * x;
-    const uchar* m = minus.ptr<uchar>(y) + Channels * x;
-    int sum = 0;
-    for (int c = 0; c < Channels; ++c)
-        sum += p[c] + m[c];
-    return static_cast<float>(sum);
-}
-
-template <int Channels>
-cv::Point2f gradient(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
-    return {
-        0.5f * (brightness<Channels>(plus, minus, x + 1, y) - brightness<Channels>(plus, minus, x - 1, y)),
-        0.5f * (brightness<Channels>(plus, minus, x, y + 1) - brightness<Channels>(plus, minus, x, y - 1))};
+cv::Point2f textureGradient(const cv::Mat& plus, const cv::Mat& minus, int x, int y) {
+    const auto texture = [&](int tx, int ty) { return channelSum<Channels, 1>(plus, minus, tx, ty); };
+    return {0.5f * (texture(x + 1, y) - texture(x - 1, y)), 0.5f * (texture(x, y + 1) - texture(x, y - 1))};
 }
 
 }  // namespace
@@ -155,7 +144,11 @@ void SurfaceHeight::clearPixels() {
 }
 
 void SurfaceHeight::addPixel(const cv::Mat& subtraction, int x, int y) {
-    values_.push_back(subtraction.at<short>(y, x));
+    addValue(subtraction.at<short>(y, x), x, y);
+}
+
+void SurfaceHeight::addValue(float value, int x, int y) {
+    values_.push_back(value);
     const cv::Vec2f& u = undistorted_.at<cv::Vec2f>(y, x);
     points_.emplace_back(u[0], u[1]);
 }
@@ -185,12 +178,11 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
             if (!m[x] || !above[x] || !below[x] || !m[x - 1] || !m[x + 1] ||
                 (x - centre.x()) * (x - centre.x()) + (y - centre.y()) * (y - centre.y()) > radius * radius)
                 continue;
-            values_.push_back(colour ? difference<3>(plus, minus, x, y) : difference<1>(plus, minus, x, y));
-            const cv::Vec2f& u = undistorted_.at<cv::Vec2f>(y, x);
-            points_.emplace_back(u[0], u[1]);
+            addValue(colour ? channelSum<3, -1>(plus, minus, x, y) : channelSum<1, -1>(plus, minus, x, y), x,
+                     y);
             if (options_.explainMotion)
-                gradients_.push_back(colour ? gradient<3>(plus, minus, x, y)
-                                            : gradient<1>(plus, minus, x, y));
+                gradients_.push_back(colour ? textureGradient<3>(plus, minus, x, y)
+                                            : textureGradient<1>(plus, minus, x, y));
         }
     }
     measurePixels(evidence);
@@ -201,7 +193,7 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
     const std::size_t n = values_.size();
     if (n < 8)
         return;
-    explainS();
+    fitResiduals();
     double varianceS = 0.0;
     for (float r : residuals_)
         varianceS += r * r;
@@ -233,7 +225,7 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
     }
 }
 
-void SurfaceHeight::explainS() {
+void SurfaceHeight::fitResiduals() {
     const std::size_t n = values_.size();
     residuals_.resize(n);
     // Least squares of S on (1, Tx, Ty) when the gradients were gathered, on 1 alone otherwise.

@@ -102,8 +102,9 @@ public:
     bool favoursUpTo(const HeightEvidence& evidence, double heightMm) const;
 
 private:
-    // residuals_ from values_ (and gradients_ when they were gathered).
-    void explainS();
+    void addValue(float value, int x, int y);
+    // residuals_: values_ less their mean and, when gradients_ were gathered, what the gradients explain.
+    void fitResiduals();
 
     HeightOptions options_;
     cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
