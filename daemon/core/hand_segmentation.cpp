@@ -62,6 +62,54 @@ float featureDistanceSquared(const float* a, const float* b) {
     return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
+// Blocks searched for colour samples around a block on the outline.
+constexpr int kColourReach = 3;
+constexpr int kColourSamples = (2 * kColourReach + 1) * (2 * kColourReach + 1);
+
+// Colour features of one side of the outline, and the squared distance from a pixel's feature to the nearest
+// of them. Each component is kept in its own array so that four samples are compared at once; the array's
+// tail repeats the last sample up to a multiple of four, which changes no minimum.
+class NearestColour {
+public:
+    void clear() { count_ = 0; }
+    bool empty() const { return count_ == 0; }
+    void add(const float* feature) {
+        const int end = (count_ + kLanes) / kLanes * kLanes;
+        for (int k = count_; k < end; ++k) {
+            first_[k] = feature[0];
+            second_[k] = feature[1];
+            third_[k] = feature[2];
+        }
+        ++count_;
+    }
+    float nearestDistance(const float* feature) const {
+        const Lanes a = {feature[0], feature[0], feature[0], feature[0]};
+        const Lanes b = {feature[1], feature[1], feature[1], feature[1]};
+        const Lanes c = {feature[2], feature[2], feature[2], feature[2]};
+        constexpr float kFar = std::numeric_limits<float>::max();
+        Lanes nearest = {kFar, kFar, kFar, kFar};
+        for (int k = 0; k < count_; k += kLanes) {
+            Lanes da, db, dc;
+            std::memcpy(&da, first_ + k, sizeof da);
+            std::memcpy(&db, second_ + k, sizeof db);
+            std::memcpy(&dc, third_ + k, sizeof dc);
+            da -= a;
+            db -= b;
+            dc -= c;
+            const Lanes distance = da * da + db * db + dc * dc;
+            nearest = distance < nearest ? distance : nearest;
+        }
+        return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
+    }
+
+private:
+    static constexpr int kLanes = 4;
+    typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
+    static constexpr int kCapacity = (kColourSamples + kLanes - 1) / kLanes * kLanes;
+    float first_[kCapacity], second_[kCapacity], third_[kCapacity];
+    int count_ = 0;
+};
+
 // Without a view beyond the projection the noise is taken as this variance of S (DN^2): a camera at its
 // default gain with some 1.4 DN of noise per frame.
 constexpr float kFallbackNoiseVariance = 4.0f;
@@ -539,25 +587,47 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     }
 }
 
+void HandSegmenter::measureDepthInHand() {
+    // The chessboard distance transform in two passes; beyond the grid lies no hand.
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    depthInHand_.create(blockClass_.size(), CV_8UC1);
+    const auto depthAt = [&](int y, int x) {
+        return y < 0 || x < 0 || y >= rows || x >= cols ? 0 : int{depthInHand_.at<uchar>(y, x)};
+    };
+    for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) {
+            int depth = 0;
+            if (isHand(blockClass_.at<uchar>(y, x)))
+                depth = 1 + std::min({depthAt(y, x - 1), depthAt(y - 1, x - 1), depthAt(y - 1, x),
+                                      depthAt(y - 1, x + 1)});
+            depthInHand_.at<uchar>(y, x) = static_cast<uchar>(std::min(depth, 255));
+        }
+    for (int y = rows - 1; y >= 0; --y)
+        for (int x = cols - 1; x >= 0; --x) {
+            const int depth =
+                std::min({int{depthInHand_.at<uchar>(y, x)}, 1 + depthAt(y, x + 1), 1 + depthAt(y + 1, x + 1),
+                          1 + depthAt(y + 1, x), 1 + depthAt(y + 1, x - 1)});
+            depthInHand_.at<uchar>(y, x) = static_cast<uchar>(depth);
+        }
+}
+
 void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
     const int rows = blockClass_.rows, cols = blockClass_.cols, blockPx = options_.blockPx;
     const int channels = texture.channels();
     const auto classAt = [&](int y, int x) {
         return y < 0 || x < 0 || y >= rows || x >= cols ? uchar{Outside} : blockClass_.at<uchar>(y, x);
     };
-    // A hand block is pure when its eight neighbours are hand too: its colour is then a clean sample of the
-    // skin. Any other block is a sample of the other side: its window shows the table's code or no code.
-    // A window reaching over the outline makes blocks up to a window's half beyond it look like hand, so a
-    // clean sample of skin lies that far inside the region of hand blocks.
+    // A hand block is pure when the blocks within `depth` of it are hand too: its colour is then a clean
+    // sample of the skin. Any other block is a sample of the other side: its window shows the table's code
+    // or no code. A window reaching over the outline makes blocks up to a window's half beyond it look like
+    // hand, so a clean sample of skin lies that far inside the region of hand blocks.
     const int depth = options_.windowBlocks / 2 + 1;
-    const auto pure = [&](int y, int x, int reach) {
-        for (int dy = -reach; dy <= reach; ++dy)
-            for (int dx = -reach; dx <= reach; ++dx)
-                if (!isHand(classAt(y + dy, x + dx)))
-                    return false;
-        return true;
-    };
-    constexpr int kReach = 3;  // blocks searched for colour samples around a block on the outline
+    measureDepthInHand();
+    const auto pure = [&](int y, int x) { return depthInHand_.at<uchar>(y, x) > depth; };
+    constexpr int kLitReach = 1;  // the lit test averages S over 3 x 3 pixels
+    const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
+    const int litSum = static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));
+    litPatch_.resize(static_cast<std::size_t>((blockPx + 2 * kLitReach) * (blockPx + 2 * kLitReach)));
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx) {
             const uchar c = blockClass_.at<uchar>(by, bx);
@@ -570,53 +640,53 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             if (!nearHand)
                 continue;
             const cv::Rect block(bx * blockPx, by * blockPx, blockPx, blockPx);
-            if (isHand(c) && pure(by, bx, depth)) {
+            if (pure(by, bx)) {
                 fill(mask(block), 255);
                 continue;
             }
             // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
-            const float* handColours[(2 * kReach + 1) * (2 * kReach + 1)];
-            const float* otherColours[(2 * kReach + 1) * (2 * kReach + 1)];
-            int hands = 0, others = 0, looseHands = 0;
-            const float* looseHandColours[(2 * kReach + 1) * (2 * kReach + 1)];
-            for (int dy = -kReach; dy <= kReach; ++dy)
-                for (int dx = -kReach; dx <= kReach; ++dx) {
+            NearestColour hand, other, looseHand;
+            for (int dy = -kColourReach; dy <= kColourReach; ++dy)
+                for (int dx = -kColourReach; dx <= kColourReach; ++dx) {
                     const int y = by + dy, x = bx + dx;
                     const uchar n = classAt(y, x);
                     if (n == Outside)
                         continue;
                     const float* colour = blockFeature(texture, y, x);
                     if (isHand(n)) {
-                        looseHandColours[looseHands++] = colour;
-                        if (pure(y, x, depth))
-                            handColours[hands++] = colour;
+                        looseHand.add(colour);
+                        if (pure(y, x))
+                            hand.add(colour);
                     } else {
-                        otherColours[others++] = colour;
+                        other.add(colour);
                     }
                 }
-            if (hands == 0) {
-                std::copy(looseHandColours, looseHandColours + looseHands, handColours);
-                hands = looseHands;
-            }
+            const NearestColour& handSide = hand.empty() ? looseHand : hand;
             // A pixel in the hand's own shadow gets no light from the projector, and no code: whatever its
             // colour, it is not the hand (a hand over black content loses its outline pixels here too).
-            constexpr int kLitReach = 1;  // the lit test averages S over 3 x 3 pixels
             // Beyond the brightest code the table shows, S is not code but the scene changing between the two
             // frames: a moving edge or a shadow sweeping over the table. It says nothing about light.
-            const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
-            const int litSum =
-                static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));
-            for (int y = block.y; y < block.y + blockPx; ++y) {
+            const int side = blockPx + 2 * kLitReach;
+            for (int py = 0; py < side; ++py) {
+                const short* s =
+                    subtraction.ptr<short>(std::clamp(block.y - kLitReach + py, 0, subtraction.rows - 1));
+                int* patch = litPatch_.data() + py * side;
+                for (int px = 0; px < side; ++px) {
+                    const int value = s[std::clamp(block.x - kLitReach + px, 0, subtraction.cols - 1)];
+                    patch[px] = value <= motionLevel ? value : 0;
+                }
+            }
+            for (int py = 0; py < blockPx; ++py) {
+                const int y = block.y + py;
                 const uchar* row = texture.ptr<uchar>(y);
                 uchar* out = mask.ptr<uchar>(y);
-                for (int x = block.x; x < block.x + blockPx; ++x) {
+                for (int px = 0; px < blockPx; ++px) {
+                    const int x = block.x + px;
                     int localSum = 0;
-                    for (int dy = -kLitReach; dy <= kLitReach; ++dy) {
-                        const short* s = subtraction.ptr<short>(std::clamp(y + dy, 0, subtraction.rows - 1));
-                        for (int dx = -kLitReach; dx <= kLitReach; ++dx) {
-                            const int value = s[std::clamp(x + dx, 0, subtraction.cols - 1)];
-                            localSum += value <= motionLevel ? value : 0;
-                        }
+                    for (int dy = 0; dy <= 2 * kLitReach; ++dy) {
+                        const int* patch = litPatch_.data() + (py + dy) * side + px;
+                        for (int dx = 0; dx <= 2 * kLitReach; ++dx)
+                            localSum += patch[dx];
                     }
                     if (c != Grown && localSum < litSum) {
                         out[x] = 0;
@@ -626,13 +696,7 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     for (int ch = 0; ch < channels; ++ch)
                         colour[ch] = row[x * channels + ch];
                     colourFeature(colour, channels, pixel);
-                    float nearestHand = std::numeric_limits<float>::max();
-                    float nearestOther = std::numeric_limits<float>::max();
-                    for (int k = 0; k < hands; ++k)
-                        nearestHand = std::min(nearestHand, featureDistanceSquared(pixel, handColours[k]));
-                    for (int k = 0; k < others; ++k)
-                        nearestOther = std::min(nearestOther, featureDistanceSquared(pixel, otherColours[k]));
-                    out[x] = nearestHand < nearestOther ? 255 : 0;
+                    out[x] = handSide.nearestDistance(pixel) < other.nearestDistance(pixel) ? 255 : 0;
                 }
             }
         }

@@ -100,6 +100,9 @@ private:
     const float* blockFeature(const cv::Mat& texture, int by, int bx);
     void growIntoFaintBlocks(const cv::Mat& texture);
     void growOverTouchingSkin(const cv::Mat& texture);
+    // depthInHand_ receives each block's chessboard distance to the nearest block that is not hand (0 on
+    // those, 1 on the hand's outline blocks).
+    void measureDepthInHand();
     void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
     SegmentationOptions options_;
@@ -113,9 +116,11 @@ private:
     float noiseVariance_ = 0.0f;   // of S where only noise is seen (DN^2)
 
     CodeEvidence evidence_;
-    cv::Mat blockClass_;   // CV_8UC1, block grid
-    cv::Mat blockColour_;  // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
-    cv::Mat colourKnown_;  // CV_8UC1, block grid: 1 where the colour has been measured this frame
+    cv::Mat blockClass_;         // CV_8UC1, block grid
+    cv::Mat blockColour_;        // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
+    cv::Mat colourKnown_;        // CV_8UC1, block grid: 1 where the colour has been measured this frame
+    cv::Mat depthInHand_;        // CV_8UC1, block grid (measureDepthInHand)
+    std::vector<int> litPatch_;  // S around one block, as labelPixels' lit test counts it
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
