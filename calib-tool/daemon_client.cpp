@@ -1,6 +1,10 @@
 #include "daemon_client.h"
 
+#include <sys/signalfd.h>
+
 #include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cstring>
 
 #include "service/bus_names.h"
@@ -250,6 +254,228 @@ std::variant<DaemonClient::CalibrationResult, Failure> DaemonClient::calibrate(
                        "everytouchd stopped during the calibration; the previous calibration "
                        "is kept. See \"journalctl -u everytouchd\"."};
     return *follower.result;
+}
+
+namespace {
+
+constexpr std::uint64_t kFrameRateIntervalUsec = 1'000'000;
+
+// What the callbacks of followContacts leave for its loop; they only record, and never throw.
+struct ContactsFollower {
+    enum class End { None, Done, DaemonGone, Malformed, OutOfMemory };
+    struct Received {
+        double seconds = 0.0;
+        std::vector<ContactReading> contacts;
+    };
+
+    double secondsSinceStart() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+
+    sd_bus* bus = nullptr;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    std::optional<std::uint64_t> count;
+    std::uint64_t signals = 0;
+    std::vector<Received> received;  // Contacts signals not yet handed over
+    double frameRate = 0.0;
+    bool frameRateRead = false;  // a new frame rate not yet handed over
+    io::BusSlot frameRateCall;   // the last Get of FrameRate
+    bool frameRateCallPending = false;
+    End end = End::None;
+};
+
+int readContacts(sd_bus_message* message, std::vector<ContactReading>& contacts) {
+    int r = sd_bus_message_enter_container(message, 'a', "(uddbd)");
+    while (r >= 0) {
+        ContactReading contact;
+        int touching = 0;
+        r = sd_bus_message_read(message, "(uddbd)", &contact.id, &contact.x, &contact.y, &touching,
+                                &contact.heightMm);
+        if (r <= 0)
+            break;
+        contact.touching = touching != 0;
+        contacts.push_back(contact);
+    }
+    return r < 0 ? r : sd_bus_message_exit_container(message);
+}
+
+int onContactsSignal(sd_bus_message* message, void* userdata, sd_bus_error*) noexcept {
+    auto* follower = static_cast<ContactsFollower*>(userdata);
+    if (follower->end != ContactsFollower::End::None)
+        return 0;
+    try {
+        ContactsFollower::Received received{follower->secondsSinceStart(), {}};
+        if (readContacts(message, received.contacts) < 0) {
+            follower->end = ContactsFollower::End::Malformed;
+            return 0;
+        }
+        follower->received.push_back(std::move(received));
+    } catch (const std::exception&) {
+        follower->end = ContactsFollower::End::OutOfMemory;
+        return 0;
+    }
+    if (follower->count && ++follower->signals >= *follower->count)
+        follower->end = ContactsFollower::End::Done;
+    return 0;
+}
+
+int onFrameRateReply(sd_bus_message* reply, void* userdata, sd_bus_error*) noexcept {
+    auto* follower = static_cast<ContactsFollower*>(userdata);
+    follower->frameRateCallPending = false;
+    double frameRate = 0.0;
+    // An error means the daemon is going; its NameOwnerChanged says so.
+    if (!sd_bus_message_is_method_error(reply, nullptr) &&
+        sd_bus_message_read(reply, "v", "d", &frameRate) >= 0) {
+        follower->frameRate = frameRate;
+        follower->frameRateRead = true;
+    }
+    return 0;
+}
+
+// Asks for the frame rate once a second (the property does not signal its changes).
+int onFrameRateTimer(sd_event_source* source, std::uint64_t, void* userdata) noexcept {
+    auto* follower = static_cast<ContactsFollower*>(userdata);
+    if (!follower->frameRateCallPending) {
+        sd_bus_slot* raw = nullptr;
+        if (sd_bus_call_method_async(follower->bus, &raw, bus::kBusName, bus::kObjectPath,
+                                     kPropertiesInterface, "Get", onFrameRateReply, follower, "ss",
+                                     bus::kInterface, "FrameRate") >= 0) {
+            follower->frameRateCall.reset(raw);
+            follower->frameRateCallPending = true;
+        }
+    }
+    sd_event_source_set_time_relative(source, kFrameRateIntervalUsec);
+    return sd_event_source_set_enabled(source, SD_EVENT_ONESHOT);
+}
+
+int onDeadline(sd_event_source*, std::uint64_t, void* userdata) noexcept {
+    auto* follower = static_cast<ContactsFollower*>(userdata);
+    if (follower->end == ContactsFollower::End::None)
+        follower->end = ContactsFollower::End::Done;
+    return 0;
+}
+
+int onStopSignal(sd_event_source*, const signalfd_siginfo*, void* userdata) noexcept {
+    auto* follower = static_cast<ContactsFollower*>(userdata);
+    if (follower->end == ContactsFollower::End::None)
+        follower->end = ContactsFollower::End::Done;
+    return 0;
+}
+
+int onDaemonOwnerChanged(sd_bus_message* message, void* userdata, sd_bus_error*) noexcept {
+    const char* name = nullptr;
+    const char* oldOwner = nullptr;
+    const char* newOwner = nullptr;
+    // Matched on arg0, so `name` is everytouchd's; an empty new owner means it left the bus.
+    if (sd_bus_message_read(message, "sss", &name, &oldOwner, &newOwner) >= 0 && newOwner[0] == '\0')
+        static_cast<ContactsFollower*>(userdata)->end = ContactsFollower::End::DaemonGone;
+    return 0;
+}
+
+// Takes the bus off an event loop when it goes; the bus itself stays open.
+using EventAttachment = io::UniqueHandle<sd_bus, sd_bus_detach_event>;
+
+Failure cannotFollow(int r) {
+    return {kExitFailure, std::string("Cannot follow the contacts: ") + std::strerror(-r) + "."};
+}
+
+}  // namespace
+
+std::optional<Failure> DaemonClient::followContacts(const ContactsOptions& options,
+                                                    const ContactsHandler& onUpdate) {
+    ContactsFollower follower;
+    follower.bus = bus_.get();
+    follower.count = options.count;
+
+    // Subscribe first, then read the frame rate: that reply also shows that the daemon is still there.
+    sd_bus_slot* rawSlot = nullptr;
+    int r = sd_bus_match_signal(bus_.get(), &rawSlot, bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                "Contacts", onContactsSignal, &follower);
+    const io::BusSlot contactsSlot(r >= 0 ? rawSlot : nullptr);
+    if (r >= 0)
+        r = sd_bus_add_match(bus_.get(), &rawSlot,
+                             "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
+                             "interface='org.freedesktop.DBus',member='NameOwnerChanged',"
+                             "arg0='" EVERYTOUCH_BUS_ROOT "'",
+                             onDaemonOwnerChanged, &follower);
+    const io::BusSlot ownerSlot(r >= 0 ? rawSlot : nullptr);
+    if (r < 0)
+        return cannotFollow(r);
+    io::UniqueBusError error;
+    r = sd_bus_get_property_trivial(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "FrameRate",
+                                    error.get(), 'd', &follower.frameRate);
+    if (r < 0)
+        return explain(error, r, "Reading the frame rate");
+
+    sd_event* rawEvent = nullptr;
+    r = sd_event_new(&rawEvent);
+    const io::Event event(r >= 0 ? rawEvent : nullptr);
+    if (r < 0)
+        return cannotFollow(r);
+    std::vector<io::EventSource> sources;
+    sd_event_source* rawSource = nullptr;
+    // SD_EVENT_SIGNAL_PROCMASK blocks the signal while the source lives, then restores the mask.
+    for (const int signal : {SIGINT, SIGTERM}) {
+        if ((r = sd_event_add_signal(event.get(), &rawSource, signal | SD_EVENT_SIGNAL_PROCMASK, onStopSignal,
+                                     &follower)) < 0)
+            return cannotFollow(r);
+        sources.emplace_back(rawSource);
+    }
+    if ((r = sd_event_add_time_relative(event.get(), &rawSource, CLOCK_MONOTONIC, kFrameRateIntervalUsec, 0,
+                                        onFrameRateTimer, &follower)) < 0)
+        return cannotFollow(r);
+    sources.emplace_back(rawSource);
+    if (options.durationS) {
+        const auto usec = static_cast<std::uint64_t>(*options.durationS * 1e6);
+        if ((r = sd_event_add_time_relative(event.get(), &rawSource, CLOCK_MONOTONIC, usec, 0, onDeadline,
+                                            &follower)) < 0)
+            return cannotFollow(r);
+        sources.emplace_back(rawSource);
+    }
+    if ((r = sd_bus_attach_event(bus_.get(), event.get(), SD_EVENT_PRIORITY_NORMAL)) < 0)
+        return cannotFollow(r);
+    const EventAttachment attachment(bus_.get());
+
+    // Hands over what the callbacks recorded, here and not inside them, so that the handler may throw.
+    ContactsUpdate update;
+    update.frameRate = follower.frameRate;
+    onUpdate(update);
+    while (true) {
+        for (ContactsFollower::Received& received : follower.received) {
+            update.seconds = received.seconds;
+            update.contactsChanged = true;
+            update.contacts = std::move(received.contacts);
+            update.frameRate = follower.frameRate;
+            onUpdate(update);
+        }
+        follower.received.clear();
+        if (follower.frameRateRead) {
+            follower.frameRateRead = false;
+            update.seconds = follower.secondsSinceStart();
+            update.contactsChanged = false;
+            update.frameRate = follower.frameRate;
+            onUpdate(update);
+        }
+        if (follower.end != ContactsFollower::End::None)
+            break;
+        r = sd_event_run(event.get(), UINT64_MAX);
+        if (r < 0)
+            return cannotFollow(r);
+        if (sd_bus_is_open(bus_.get()) <= 0)
+            return Failure{kExitFailure, "Lost the connection to the system bus."};
+    }
+    switch (follower.end) {
+        case ContactsFollower::End::DaemonGone:
+            return Failure{
+                kExitNotRunning,
+                "everytouchd stopped (it left the system bus); see \"journalctl -u everytouchd\"."};
+        case ContactsFollower::End::Malformed:
+            return Failure{kExitFailure, "everytouchd sent a malformed Contacts signal."};
+        case ContactsFollower::End::OutOfMemory:
+            return Failure{kExitFailure, "Out of memory."};
+        default:
+            return std::nullopt;
+    }
 }
 
 }  // namespace everytouch::calib

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include <systemd/sd-bus.h>
 
@@ -27,6 +28,15 @@ struct Failure {
 };
 
 using PropertyValue = std::variant<std::string, bool, double, std::uint32_t, std::uint64_t>;
+
+// One finger as the daemon's Contacts signal carries it.
+struct ContactReading {
+    std::uint32_t id = 0;   // stable while the finger is tracked
+    double x = 0.0;         // display pixels
+    double y = 0.0;         // display pixels
+    bool touching = false;  // at or below the touch height
+    double heightMm = 0.0;  // the finger pad's height above the table
+};
 
 // A connection to everytouchd over the system bus. Every call returns a Failure phrased for the user, with
 // `action` ("Setting the touch height") naming what was attempted.
@@ -58,6 +68,22 @@ public:
     std::variant<CalibrationResult, Failure> calibrate(const std::string& step,
                                                        const CalibrationOptions& options,
                                                        const ProgressHandler& onProgress);
+
+    struct ContactsOptions {
+        std::optional<std::uint64_t> count;  // end after this many Contacts signals
+        std::optional<double> durationS;     // end after this many seconds
+    };
+    // What the daemon reported last, handed over after each Contacts signal and each new frame rate.
+    struct ContactsUpdate {
+        double seconds = 0.0;          // since following began
+        bool contactsChanged = false;  // false: only the frame rate was read again
+        std::vector<ContactReading> contacts;
+        double frameRate = 0.0;  // frames per second, read once a second
+    };
+    using ContactsHandler = std::function<void(const ContactsUpdate& update)>;
+    // Follows the Contacts signal until `options` are met or SIGINT or SIGTERM arrives (then nothing is
+    // returned), or until the daemon leaves the bus (a Failure). `onUpdate` runs outside sd-bus callbacks.
+    std::optional<Failure> followContacts(const ContactsOptions& options, const ContactsHandler& onUpdate);
 
 private:
     explicit DaemonClient(io::Bus bus) : bus_(std::move(bus)) {}

@@ -1,4 +1,4 @@
-// everytouch-calib: calibrates everytouchd and shows its status, over D-Bus.
+// everytouch-calib: calibrates everytouchd and shows its status and contacts, over D-Bus.
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "contacts_view.h"
 #include "daemon_client.h"
 #include "io/handles.h"
 #include "version.h"
@@ -165,6 +166,17 @@ int calibrate(const std::string& step, const DaemonClient::CalibrationOptions& o
     return calib::kExitOk;
 }
 
+int monitor(const DaemonClient::ContactsOptions& options) {
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    calib::ContactsView view(stdout, ::isatty(STDOUT_FILENO));
+    if (auto failure = std::get<DaemonClient>(client).followContacts(
+            options, [&view](const DaemonClient::ContactsUpdate& update) { view.show(update); }))
+        return report(*failure);
+    return calib::kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -216,6 +228,16 @@ int main(int argc, char** argv) {
     snapshotCommand->add_option("WHAT", what, "camera, texture, subtraction, mask or overlay")->required();
     snapshotCommand->add_option("FILE", file, "The PNG file to write")->required();
 
+    DaemonClient::ContactsOptions monitorOptions;
+    CLI::App* monitorCommand = app.add_subcommand(
+        "monitor",
+        "Show the contacts live (id, position in display pixels, touching or hover height) and the frame "
+        "rate; until Ctrl+C");
+    monitorCommand->add_option("--count", monitorOptions.count, "End after N changes of contacts")
+        ->check(CLI::PositiveNumber);
+    monitorCommand->add_option("--duration", monitorOptions.durationS, "End after S seconds")
+        ->check(CLI::Range(0.001, 1e9));
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
@@ -230,5 +252,7 @@ int main(int argc, char** argv) {
         return sensitivity(heightMm);
     if (snapshotCommand->parsed())
         return snapshot(what, file);
+    if (monitorCommand->parsed())
+        return monitor(monitorOptions);
     return calib::kExitUsage;
 }

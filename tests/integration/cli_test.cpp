@@ -128,6 +128,23 @@ TEST(EverytouchCalib, HelpDocumentsExitCodes) {
     EXPECT_THAT(result.out, HasSubstr("status"));
 }
 
+TEST(EverytouchCalib, MonitorHelpNamesItsOptions) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "monitor", "--help"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.out, HasSubstr("--count"));
+    EXPECT_THAT(result.out, HasSubstr("--duration"));
+}
+
+TEST(EverytouchCalib, MonitorRefusesACountOrDurationOfNothingAsUsage) {
+    for (const std::vector<std::string>& option :
+         {std::vector<std::string>{"--count", "0"}, {"--duration", "0"}, {"--duration", "-1"}}) {
+        const test::ProcessResult result =
+            test::runProcess({EVERYTOUCH_CALIB_PATH, "monitor", option[0], option[1]});
+        EXPECT_EQ(result.exitCode, 2) << option[0] << " " << option[1];
+        EXPECT_THAT(result.err, HasSubstr(option[0])) << option[0] << " " << option[1];
+    }
+}
+
 TEST(EverytouchCalib, VersionPrintsNameAndVersion) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "--version"});
     EXPECT_EQ(result.exitCode, 0);

@@ -5,8 +5,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <fstream>
 #include <memory>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <thread>
 
 #include <opencv2/core.hpp>
@@ -22,6 +28,7 @@
 #include "io/calibration_file.h"
 #include "io/handles.h"
 #include "io/recording.h"
+#include "io/touch_log.h"
 #include "service/bus_names.h"
 #include "service/table_set_up_step.h"
 #include "sim/rig_geometry.h"
@@ -880,11 +887,183 @@ TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
 
 TEST_F(ServiceTest, TheToolSaysWhenTheDaemonIsNotRunning) {
     for (const std::vector<std::string>& command : {std::vector<std::string>{EVERYTOUCH_CALIB_PATH, "status"},
-                                                    {EVERYTOUCH_CALIB_PATH, "sensitivity", "4"}}) {
+                                                    {EVERYTOUCH_CALIB_PATH, "sensitivity", "4"},
+                                                    {EVERYTOUCH_CALIB_PATH, "monitor", "--count", "1"}}) {
         const test::ProcessResult result = test::runProcess(command);
         EXPECT_EQ(result.exitCode, 3);
         EXPECT_THAT(result.err, HasSubstr("everytouchd is not running"));
     }
+}
+
+// everytouch-calib monitor, not on a terminal: one line per Contacts signal.
+struct MonitorContact {
+    std::uint32_t id = 0;
+    double x = 0.0, y = 0.0;  // display pixels, rounded
+    bool touching = false;
+    double heightMm = 0.0;  // rounded; only for hovering contacts
+};
+struct MonitorLine {
+    std::string text;
+    double seconds = 0.0;
+    std::size_t count = 0;
+    std::vector<MonitorContact> contacts;
+    double frameRate = 0.0;
+};
+
+// The lines of the form "12.345 s  2 contacts  #3 (812, 404) touching  #4 (900, 380) hover 12 mm   118.9
+// frames/s" in `text`, and how many other lines there were.
+std::vector<MonitorLine> parseMonitorLines(const std::string& text, std::size_t& otherLines) {
+    static const std::regex kLine(
+        R"(^(\d+\.\d{3}) s  (\d+) contacts?((?:  #\d+ \(-?\d+, -?\d+\) (?:touching|hover -?\d+ mm))*)   (\d+\.\d) frames/s$)");
+    static const std::regex kContact(R"(#(\d+) \((-?\d+), (-?\d+)\) (?:touching|hover (-?\d+) mm))");
+    std::vector<MonitorLine> lines;
+    otherLines = 0;
+    std::istringstream stream(text);
+    for (std::string line; std::getline(stream, line);) {
+        std::smatch match;
+        if (!std::regex_match(line, match, kLine)) {
+            ++otherLines;
+            continue;
+        }
+        MonitorLine parsed;
+        parsed.text = line;
+        parsed.seconds = std::stod(match[1]);
+        parsed.count = std::stoul(match[2]);
+        parsed.frameRate = std::stod(match[4]);
+        const std::string contacts = match[3];
+        for (auto it = std::sregex_iterator(contacts.begin(), contacts.end(), kContact);
+             it != std::sregex_iterator(); ++it) {
+            const std::smatch& found = *it;
+            MonitorContact contact;
+            contact.id = static_cast<std::uint32_t>(std::stoul(found[1]));
+            contact.x = std::stod(found[2]);
+            contact.y = std::stod(found[3]);
+            contact.touching = !found[4].matched;
+            contact.heightMm = found[4].matched ? std::stod(found[4]) : 0.0;
+            parsed.contacts.push_back(contact);
+        }
+        lines.push_back(parsed);
+    }
+    return lines;
+}
+
+// Whether `line` shows `contacts` as the monitor rounds them.
+bool showsContacts(const MonitorLine& line, const core::Contacts& contacts) {
+    if (line.contacts.size() != contacts.size())
+        return false;
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+        const MonitorContact& shown = line.contacts[i];
+        const core::Contact& contact = contacts[i];
+        if (shown.id != contact.id || std::abs(shown.x - contact.x) > 0.5 ||
+            std::abs(shown.y - contact.y) > 0.5 || shown.touching != contact.touching ||
+            (!contact.touching && std::abs(shown.heightMm - contact.heightMm) > 0.5))
+            return false;
+    }
+    return true;
+}
+
+// Waits until a monitor running beside the test has written a line.
+bool waitForALine(const test::BackgroundProcess& monitor) {
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+        if (monitor.output().find(" frames/s\n") != std::string::npos)
+            return true;
+        std::this_thread::sleep_for(20ms);
+    }
+    return false;
+}
+
+// The hand of the grid35 session comes in from beyond the display's edge after 0.6 s, lowers a finger and
+// taps the circles one by one: contacts that hover, touch and move within a few seconds of the start.
+constexpr const char* kTappingRig = "sim:grid35";
+
+TEST_F(ServiceTest, TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem) {
+    startDaemonOn(kTappingRig, {"--log", (dir_ / "touches.jsonl").string()});
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    double frameRate = 0.0;
+    while (std::chrono::steady_clock::now() < deadline && !(frameRate > 0.0)) {
+        std::this_thread::sleep_for(100ms);
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &frameRate);
+    }
+    ASSERT_GT(frameRate, 0.0) << "no frames arrive";
+
+    constexpr std::size_t kCount = 100;
+    const test::ProcessResult result = test::runProcess(
+        {EVERYTOUCH_CALIB_PATH, "monitor", "--count", std::to_string(kCount), "--duration", "60"});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    std::size_t otherLines = 0;
+    const std::vector<MonitorLine> lines = parseMonitorLines(result.out, otherLines);
+    EXPECT_EQ(otherLines, 0u) << result.out;
+    ASSERT_EQ(lines.size(), kCount) << "--count ends it, not --duration:\n" << result.out;
+
+    const cv::Size display = sim::SimParameters{}.displaySize;
+    std::set<std::uint32_t> ids;
+    std::size_t touching = 0, hovering = 0;
+    double previousSeconds = 0.0;
+    for (const MonitorLine& line : lines) {
+        EXPECT_GE(line.seconds, previousSeconds) << result.out;
+        EXPECT_LT(line.seconds, 60.0);
+        previousSeconds = line.seconds;
+        EXPECT_GT(line.frameRate, 0.0) << result.out;
+        EXPECT_LE(line.frameRate, 130.0) << "the simulated camera runs at 120 frames/s";
+        EXPECT_EQ(line.count, line.contacts.size()) << result.out;
+        for (const MonitorContact& contact : line.contacts) {
+            ids.insert(contact.id);
+            EXPECT_GE(contact.x, 0.0) << result.out;
+            EXPECT_LE(contact.x, display.width) << result.out;
+            EXPECT_GE(contact.y, 0.0) << result.out;
+            EXPECT_LE(contact.y, display.height) << result.out;
+            (contact.touching ? touching : hovering) += 1;
+        }
+    }
+    EXPECT_FALSE(ids.empty()) << "no contact in " << kCount << " changes:\n" << result.out;
+    EXPECT_GT(touching, 0u) << result.out;
+    EXPECT_GT(hovering, 0u) << result.out;
+
+    // Every line shows the contacts of a frame the daemon logged: the same ids, positions, states, heights.
+    daemon_->signal(SIGTERM);
+    ASSERT_EQ(daemon_->wait(kExitTimeout), 0);
+    const std::vector<io::TouchLogEntry> log = io::readTouchLog(dir_ / "touches.jsonl");
+    std::string unlogged;
+    for (const MonitorLine& line : lines)
+        if (!line.contacts.empty() &&
+            std::none_of(log.begin(), log.end(),
+                         [&](const io::TouchLogEntry& entry) { return showsContacts(line, entry.contacts); }))
+            unlogged += line.text + "\n";
+    EXPECT_EQ(unlogged, "") << "lines whose contacts the touch log does not hold";
+}
+
+TEST_F(ServiceTest, TheMonitorEndsAfterItsDurationAndOnSigintOrSigterm) {
+    startDaemonOn(kTappingRig);
+    const auto started = std::chrono::steady_clock::now();
+    const test::ProcessResult result =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "monitor", "--duration", "1.5"});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_GE(seconds, 1.5);
+    EXPECT_LT(seconds, 20.0);
+    std::size_t otherLines = 0;
+    for (const MonitorLine& line : parseMonitorLines(result.out, otherLines))
+        EXPECT_LT(line.seconds, seconds) << result.out;
+    EXPECT_EQ(otherLines, 0u) << result.out;
+
+    for (const int signal : {SIGINT, SIGTERM}) {
+        test::BackgroundProcess monitor({EVERYTOUCH_CALIB_PATH, "monitor"}, dir_ / "monitor.log");
+        // A first line: it follows the contacts, its signal handling in place.
+        ASSERT_TRUE(waitForALine(monitor)) << monitor.output();
+        monitor.signal(signal);
+        EXPECT_EQ(monitor.wait(kExitTimeout), 0) << strsignal(signal) << "\n" << monitor.output();
+    }
+}
+
+TEST_F(ServiceTest, TheMonitorSaysWhenTheDaemonStops) {
+    startDaemonOn(kTappingRig);
+    test::BackgroundProcess monitor({EVERYTOUCH_CALIB_PATH, "monitor"}, dir_ / "monitor.log");
+    ASSERT_TRUE(waitForALine(monitor)) << monitor.output();
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0);
+    EXPECT_EQ(monitor.wait(kExitTimeout), 3) << monitor.output();
+    EXPECT_THAT(monitor.output(), HasSubstr("everytouchd stopped"));
 }
 
 TEST_F(ServiceTest, TheToolPassesCalibrationOptionsOn) {
