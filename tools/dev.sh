@@ -60,7 +60,8 @@ test)
 sanitize)
     install_missing_packages
     # Warnings are enforced by the normal build; GCC's flow analysis under ASan reports false positives.
-    # -O1 -g1 keeps file:line in every report and halves the compile time of -O2 -g under ASan.
+    # -O1 -g1 keeps file:line in every report and halves the compile time of -O2 -g under ASan (the test
+    # cases themselves compile at -O0: tests/CMakeLists.txt).
     build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF -DEVERYTOUCH_WERROR=OFF \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
     # The projector step end to end on the simulated rig renders some 500 frames of a moving board, minutes
