@@ -509,7 +509,9 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     uchar* classes = blockClass_.ptr<uchar>();
     const double blockMm = options_.blockPx / pixelsPerMm_;
     const int reach = std::max(1, static_cast<int>(std::lround(0.5 * options_.fingerWidthMm / blockMm)));
-    const int sampleReach = reach + 1;  // where the table's colour is sampled, beyond the reach
+    // The table's colour is sampled beyond the reach, up to a finger's width further: a block inside a finger
+    // that lies low (its whole length near the table on a slide) is that far from the table on either side.
+    const int sampleReach = reach + 2 * reach;
 
     // Blocks to the nearest hand block, up to the farthest a table sample lies from the hand.
     constexpr int kFar = std::numeric_limits<int>::max();
