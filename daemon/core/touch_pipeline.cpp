@@ -158,11 +158,12 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
         finger.heightKnown = observation.visible.valid;
-        // This frame's evidence alone: a finger rising from the table stays put in the image, and its
-        // earlier frames' evidence would hold it down.
+        // From the evidence the height was sought in: a slide's frames add up to a lean where one frame
+        // is too faint. A rising finger also stays put in the image, but its lift shows a height above the
+        // touch height before its code fades, and the tracker then lifts it at once.
         if (!finger.heightKnown)
             finger.codeFavoursTable =
-                height_.favoursUpTo(frameEvidence_, settings.touchHeightMm + options_.visibleAbovePadMm);
+                height_.favoursUpTo(memory.evidence, settings.touchHeightMm + options_.visibleAbovePadMm);
         finger.padHeightMm = observation.padHeightMm;
         if (finger.heightKnown)
             finger.heightUncertaintyMm =

@@ -18,7 +18,8 @@ struct DiskScore {
 
 // The hand's pixels within `radiusMm` of every touching pad, as the truth and the segmentation see them, over
 // frames sampled across the scenario's cycle.
-DiskScore scoreTouchingEnds(const std::string& scenario, const SegmentationOptions& options, double radiusMm) {
+DiskScore scoreTouchingEnds(const std::string& scenario, const SegmentationOptions& options,
+                            double radiusMm) {
     sim::SimParameters parameters;
     parameters.scenario = scenario;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));

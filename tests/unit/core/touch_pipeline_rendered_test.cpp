@@ -1,0 +1,78 @@
+// The whole pipeline on rendered frames: what a user feels of a drag.
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "core/touch_pipeline.h"
+#include "sim/simulator.h"
+
+namespace everytouch::core {
+namespace {
+
+struct DragScore {
+    int drags = 0;           // runs of frames in which a finger lies on the table
+    int slideFrames = 0;     // frames in which a finger lies on the table
+    int touchingFrames = 0;  // of those, frames with a touching contact
+    int touchDowns = 0;      // contacts that went down while a finger lay on the table
+};
+
+DragScore scoreDrags(const std::string& scenario) {
+    sim::SimParameters parameters;
+    parameters.scenario = scenario;
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    TouchPipeline pipeline;
+    PipelineSettings settings;
+    settings.calibration = simulator.calibration();
+    settings.pattern = simulator.pattern();
+    settings.touchHeightMm = 3.0;
+
+    DragScore score;
+    Frame older, newer;
+    sim::FrameTruth olderTruth, truth;
+    std::set<std::uint32_t> down;
+    bool wasOnTable = false;
+    const auto frames =
+        static_cast<std::uint64_t>(simulator.scenario().cycleSeconds() * parameters.frameRate);
+    simulator.render(0, older, olderTruth);
+    for (std::uint64_t index = 1; index < frames; ++index) {
+        simulator.render(index, newer, truth);
+        const bool olderPositive = older.polarity == Polarity::Positive;
+        const PipelineResult& result = pipeline.process(
+            FramePair{olderPositive ? older : newer, olderPositive ? newer : older}, settings);
+        std::swap(older, newer);
+
+        bool onTable = false;
+        for (const sim::FingertipTruth& finger : truth.fingertips)
+            onTable = onTable || (finger.presented && finger.touching);
+        std::set<std::uint32_t> nowDown;
+        for (const Contact& contact : result.contacts)
+            if (contact.touching)
+                nowDown.insert(contact.id);
+        if (onTable) {
+            score.drags += wasOnTable ? 0 : 1;
+            ++score.slideFrames;
+            score.touchingFrames += nowDown.empty() ? 0 : 1;
+            for (std::uint32_t id : nowDown)
+                score.touchDowns += down.count(id) ? 0 : 1;
+        }
+        down = nowDown;
+        wasOnTable = onTable;
+    }
+    return score;
+}
+
+TEST(TouchPipelineRendered, ADragStaysOneTouch) {
+    // The drag scenario's finger slides along a square, a triangle and a circle: each drag should be one
+    // touch from its touch-down to its lift, whatever the code on the sliding skin lets the height read.
+    const DragScore score = scoreDrags("drag");
+    ASSERT_GT(score.slideFrames, 300) << "the test needs a finger sliding on the table";
+    EXPECT_GE(static_cast<double>(score.touchingFrames) / score.slideFrames, 0.8)
+        << score.touchingFrames << " of " << score.slideFrames << " frames";
+    // One touch-down a drag is the goal. 10 in the 3 drags as measured, 17 when a frame without a height
+    // leant to the table on its own evidence only: a slide's breaks are runs of frames whose code is too
+    // faint on the moving skin (docs/detection.md).
+    EXPECT_LE(score.touchDowns, 13) << "touch-downs in " << score.drags << " drags";
+}
+
+}  // namespace
+}  // namespace everytouch::core
