@@ -999,13 +999,16 @@ TEST_F(ServiceTest, TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem) {
     const cv::Size display = sim::SimParameters{}.displaySize;
     std::set<std::uint32_t> ids;
     std::size_t touching = 0, hovering = 0;
-    double previousSeconds = 0.0;
+    double previousSeconds = 0.0, highestFrameRate = 0.0;
     for (const MonitorLine& line : lines) {
         EXPECT_GE(line.seconds, previousSeconds) << result.out;
         EXPECT_LT(line.seconds, 60.0);
         previousSeconds = line.seconds;
-        EXPECT_GT(line.frameRate, 0.0) << result.out;
+        // The daemon's rate of arrivals over its recent window: 0 when fewer than two frames arrived in it,
+        // as they do now and then on a loaded machine under the sanitizers (4 frames/s).
+        EXPECT_GE(line.frameRate, 0.0) << result.out;
         EXPECT_LE(line.frameRate, 130.0) << "the simulated camera runs at 120 frames/s";
+        highestFrameRate = std::max(highestFrameRate, line.frameRate);
         EXPECT_EQ(line.count, line.contacts.size()) << result.out;
         for (const MonitorContact& contact : line.contacts) {
             ids.insert(contact.id);
@@ -1016,6 +1019,7 @@ TEST_F(ServiceTest, TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem) {
             (contact.touching ? touching : hovering) += 1;
         }
     }
+    EXPECT_GT(highestFrameRate, 0.0) << result.out;
     EXPECT_FALSE(ids.empty()) << "no contact in " << kCount << " changes:\n" << result.out;
     EXPECT_GT(touching, 0u) << result.out;
     EXPECT_GT(hovering, 0u) << result.out;
