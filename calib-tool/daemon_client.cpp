@@ -13,6 +13,11 @@ namespace everytouch::calib {
 
 namespace {
 
+// The bus's signal that the daemon's name changed owner: it started, or it left the bus.
+constexpr const char* kDaemonOwnerChanged =
+    "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
+    "interface='org.freedesktop.DBus',member='NameOwnerChanged',arg0='" EVERYTOUCH_BUS_ROOT "'";
+
 constexpr const char* kPropertiesInterface = "org.freedesktop.DBus.Properties";
 
 Failure notRunning() {
@@ -203,11 +208,7 @@ std::variant<DaemonClient::CalibrationResult, Failure> DaemonClient::calibrate(
                                 "CalibrationFinished", onFinishedSignal, &follower);
     const io::BusSlot finishedSlot(r >= 0 ? raw : nullptr);
     if (r >= 0)
-        r = sd_bus_add_match(bus_.get(), &raw,
-                             "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
-                             "interface='org.freedesktop.DBus',member='NameOwnerChanged',"
-                             "arg0='" EVERYTOUCH_BUS_ROOT "'",
-                             onOwnerChanged, &follower);
+        r = sd_bus_add_match(bus_.get(), &raw, kDaemonOwnerChanged, onOwnerChanged, &follower);
     const io::BusSlot ownerSlot(r >= 0 ? raw : nullptr);
     if (r < 0)
         return Failure{kExitFailure,
@@ -393,11 +394,7 @@ std::optional<Failure> DaemonClient::followContacts(const ContactsOptions& optio
                                 "Contacts", onContactsSignal, &follower);
     const io::BusSlot contactsSlot(r >= 0 ? rawSlot : nullptr);
     if (r >= 0)
-        r = sd_bus_add_match(bus_.get(), &rawSlot,
-                             "type='signal',sender='org.freedesktop.DBus',path='/org/freedesktop/DBus',"
-                             "interface='org.freedesktop.DBus',member='NameOwnerChanged',"
-                             "arg0='" EVERYTOUCH_BUS_ROOT "'",
-                             onDaemonOwnerChanged, &follower);
+        r = sd_bus_add_match(bus_.get(), &rawSlot, kDaemonOwnerChanged, onDaemonOwnerChanged, &follower);
     const io::BusSlot ownerSlot(r >= 0 ? rawSlot : nullptr);
     if (r < 0)
         return cannotFollow(r);
