@@ -4,25 +4,32 @@
 # systemd-udevd, the input rules, libinput, evemu and dbus-daemon. All cases run in one boot. Exit 0 iff the
 # guest reports "VMTEST RESULT: PASS".
 #
-# usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR
+# The daemon replays a recording in the guest that the same daemon makes here first from the simulated rig
+# --recording-rig names (rendering under emulation would take minutes); it is kept in DIR/recording while the
+# daemon binary and the rig stay the same.
+#
+# usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR --recording-rig sim:SPEC
 # environment: EVERYTOUCH_VM_CACHE  where the kernel is kept between runs (default: DIR/cache)
 #              EVERYTOUCH_VM_KERNEL_PACKAGE  a linux-image-* package to use instead of linux-image-amd64's
 #              EVERYTOUCH_VM_TIMEOUT  seconds the guest may run (default 600)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 
-work="" test_binary="" daemon="" rules=""
+work="" test_binary="" daemon="" rules="" recording_rig=""
 while [ $# -gt 0 ]; do
     case "$1" in
     --work) work=$2; shift 2 ;;
     --test) test_binary=$2; shift 2 ;;
     --daemon) daemon=$2; shift 2 ;;
     --rules) rules=$2; shift 2 ;;
+    --recording-rig) recording_rig=$2; shift 2 ;;
     *) echo "run-vm-test.sh: unknown argument $1" >&2; exit 2 ;;
     esac
 done
-[ -n "$work" ] && [ -x "$test_binary" ] && [ -x "$daemon" ] && [ -d "$rules" ] || {
-    echo "usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR" >&2; exit 2; }
+[ -n "$work" ] && [ -x "$test_binary" ] && [ -x "$daemon" ] && [ -d "$rules" ] && [ -n "$recording_rig" ] || {
+    echo "usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR --recording-rig sim:SPEC" >&2
+    exit 2
+}
 
 fail() { echo "run-vm-test.sh: $*" >&2; exit 1; }
 need() { command -v "$1" >/dev/null || fail "$1 is missing (Debian package $2; tools/dev.sh installs it)"; }
@@ -90,6 +97,20 @@ if [ ! -f "$kernel_dir/ready" ]; then
 fi
 fetched=$(date +%s.%N)
 
+# --- the recording the daemon replays in the guest ---
+recording=$work/recording
+stamp="$recording_rig $(sha256sum <"$daemon" | cut -d' ' -f1)"
+if [ "$(cat "$recording.stamp" 2>/dev/null)" != "$stamp" ]; then
+    echo "recording $recording_rig"
+    rm -rf "$recording" "$recording.stamp"
+    # No bus: a daemon running on this machine keeps its name.
+    DBUS_SYSTEM_BUS_ADDRESS=unix:path=$work/no-bus \
+        "$daemon" --rig "$recording_rig" --fast --record "$recording" >"$work/recording.log" 2>&1 || {
+        cat "$work/recording.log" >&2; fail "everytouchd could not record $recording_rig"; }
+    echo "$stamp" >"$recording.stamp"
+fi
+recorded=$(date +%s.%N)
+
 # --- the initramfs: busybox, udev, libinput, evemu, our binaries and every library they load ---
 root=$work/root
 rm -rf "$root"
@@ -130,6 +151,8 @@ cp "$test_binary" "$root/usr/local/bin/uinput_device_tests"
 copy_libraries "$test_binary"
 cp "$daemon" "$root/usr/local/bin/everytouchd"
 copy_libraries "$daemon"
+mkdir -p "$root/usr/local/share/everytouch"
+cp -r "$recording" "$root/usr/local/share/everytouch/recording"
 echo 'root:x:0:0:root:/root:/bin/sh' >"$root/etc/passwd"
 printf 'root:x:0:\ninput:x:101:\n' >"$root/etc/group"
 cp "$here/init" "$root/init"
@@ -150,6 +173,7 @@ timeout --foreground -k 5 "${EVERYTOUCH_VM_TIMEOUT:-600}" qemu-system-x86_64 \
 qemu_status=${PIPESTATUS[0]}
 set -e
 finished=$(date +%s.%N)
-awk -v s="$started" -v f="$fetched" -v p="$packed" -v e="$finished" -v q="$qemu_status" 'BEGIN {
-    printf "vm timings: kernel %.1f s, initramfs %.1f s, guest %.1f s, total %.1f s (qemu exit %d)\n", f - s, p - f, e - p, e - s, q }'
+awk -v s="$started" -v f="$fetched" -v r="$recorded" -v p="$packed" -v e="$finished" -v q="$qemu_status" 'BEGIN {
+    printf "vm timings: kernel %.1f s, recording %.1f s, initramfs %.1f s, guest %.1f s, total %.1f s (qemu exit %d)\n",
+        f - s, r - f, p - r, e - p, e - s, q }'
 grep -q '^VMTEST RESULT: PASS' "$console"

@@ -9,8 +9,10 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <limits>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -19,6 +21,8 @@
 
 #include "io/handles.h"
 #include "io/recording.h"
+#include "io/touch_log.h"
+#include "io/touchscreen_axes.h"
 #include "io/uinput_sink.h"
 #include "service/bus_names.h"
 #include "support/file_contents.h"
@@ -445,7 +449,8 @@ std::string busDevicePath() {
 
 // The daemon on a recording of the paper rig, with --output uinput: the touchscreen it creates has the size
 // of the recorded rig's projected display, its node is the daemon's DevicePath on the bus, and it goes away
-// with the daemon. (Contacts follow once detection is part of the pipeline.)
+// with the daemon. The recording's frames are blank; Everytouchd.ReplaysARecordedDragOntoItsTouchscreen
+// follows a finger the daemon detects onto the screen.
 TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
     SKIP_WITHOUT_UINPUT();
     test::TempDir dir;
@@ -495,6 +500,232 @@ TEST(Everytouchd, CreatesTheVirtualTouchscreenOfItsRig) {
     EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); }))
         << "the touchscreen outlived the daemon";
     std::cout << "everytouchd log:\n" << test::fileContents(dir / "daemon.log");
+}
+
+// The input event nodes there are now.
+std::set<std::filesystem::path> eventNodes() {
+    std::set<std::filesystem::path> nodes;
+    for (const auto& entry : std::filesystem::directory_iterator("/dev/input"))
+        if (entry.path().filename().string().starts_with("event"))
+            nodes.insert(entry.path());
+    return nodes;
+}
+
+// Whether a touch log, as far as its lines are complete, has a frame without touches after one with a touch.
+bool logsALift(const std::string& log) {
+    bool touched = false;
+    for (std::size_t start = 0, end; (end = log.find('\n', start)) != std::string::npos; start = end + 1) {
+        const bool touching = log.substr(start, end - start).find("\"touch\":true") != std::string::npos;
+        if (touched && !touching)
+            return true;
+        touched = touched || touching;
+    }
+    return false;
+}
+
+// A touching finger in the daemon's touch log, where the device reports it.
+struct LoggedTouch {
+    std::uint64_t index = 0;  // frame
+    std::size_t entry = 0;    // position in the log
+    std::uint32_t id = 0;
+    bool begins = false;   // not touching in the entry before
+    cv::Point2d px;        // display pixels, as logged
+    cv::Point2d deviceMm;  // through the touchscreen's axes, as libinput computes it
+    cv::Point2i units;     // the axis units the position rounds to
+};
+
+std::vector<LoggedTouch> loggedTouches(const std::vector<io::TouchLogEntry>& log,
+                                       const io::TouchscreenAxes& axes) {
+    std::vector<LoggedTouch> touches;
+    std::set<std::uint32_t> touching;
+    for (std::size_t i = 0; i < log.size(); ++i) {
+        std::set<std::uint32_t> now;
+        for (const core::Contact& contact : log[i].contacts) {
+            if (!contact.touching || contact.palm)
+                continue;
+            now.insert(contact.id);
+            const cv::Point2i units(axes.unitsX(contact.x), axes.unitsY(contact.y));
+            touches.push_back({log[i].index,
+                               i,
+                               contact.id,
+                               !touching.contains(contact.id),
+                               {contact.x, contact.y},
+                               {static_cast<double>(units.x) / axes.resolutionX,
+                                static_cast<double>(units.y) / axes.resolutionY},
+                               units});
+        }
+        touching = now;
+    }
+    return touches;
+}
+
+// The nearest true contact point of frame `index`, in mm from `mm` on the table; infinite without one.
+double truthDistanceMm(const io::Recording& recording, std::uint64_t index, const cv::Point2d& mm) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const core::FingerTruth& finger : recording.truth())
+        if (finger.frameIndex == index)
+            nearest =
+                std::min(nearest, cv::norm(expectedMm(recording.rig().calibration, finger.x, finger.y) - mm));
+    return nearest;
+}
+
+// How far a reported touch may lie from the true contact point: everytouch-eval's match radius, half a
+// finger's width, the middle between a finger's contact point and its neighbour's; further off, the touch
+// could be the neighbour's. The pipeline's touches on this drag lie within about 3 mm of the truth, most of
+// it the lag of its filter behind the sliding finger.
+constexpr double kTruthToleranceMm = 8.0;
+
+// everytouchd replays a recording of the simulated rig (run-vm-test.sh makes it on the host, where rendering
+// is fast) with --output uinput: the last 0.5 s (28 mm) of a finger dragged along a side of a square, held
+// still and lifted. libinput sees the daemon's touches exactly as its touch log has them, each frame's move
+// as its own motion, and where the true finger is.
+TEST(Everytouchd, ReplaysARecordedDragOntoItsTouchscreen) {
+    SKIP_WITHOUT_UINPUT();
+    const char* recordingPath = std::getenv("EVERYTOUCH_TEST_RECORDING");
+    if (!recordingPath)
+        GTEST_SKIP() << "EVERYTOUCH_TEST_RECORDING names no recording with a touch (tests/vm sets it)";
+    const io::Recording recording = io::Recording::open(recordingPath);
+    ASSERT_TRUE(recording.hasTruth()) << recordingPath << " has no truth.csv";
+    const core::Calibration& calibration = recording.rig().calibration;
+    const io::TouchscreenAxes axes =
+        io::TouchscreenAxes::forDisplay(calibration.displaySize, calibration.displaySizeMm());
+
+    test::TempDir dir;
+    const std::set<std::filesystem::path> before = eventNodes();
+    const char* daemonPath = std::getenv("EVERYTOUCHD");
+    // --fast: every frame is processed, however slowly this machine runs the pipeline, as on the host.
+    test::BackgroundProcess daemon(
+        {daemonPath ? daemonPath : EVERYTOUCHD_PATH, "--rig", std::string("replay:") + recordingPath,
+         "--fast", "--output", "uinput", "--log", (dir / "touches.jsonl").string()},
+        dir / "daemon.log");
+    // The daemon is held as soon as its touchscreen appears, until libinput has it open: the finger touches
+    // within the first frames.
+    std::filesystem::path devnode;
+    const bool appeared = waitFor(
+        [&] {
+            for (const std::filesystem::path& node : eventNodes())
+                if (!before.contains(node))
+                    devnode = node;
+            return !devnode.empty() || !daemon.running();
+        },
+        kPatience);
+    daemon.signal(SIGSTOP);
+    ASSERT_TRUE(appeared && !devnode.empty()) << "no touchscreen appeared\n" << daemon.output();
+    ASSERT_THAT(udevProperties(devnode), HasSubstr("E:ID_INPUT_TOUCHSCREEN=1"));
+    test::BackgroundProcess libinput({"libinput", "debug-events", "--device", devnode.string()},
+                                     dir / "libinput.txt");
+    const bool opened = attached(libinput, devnode);
+    ASSERT_TRUE(test::fileContents(dir / "touches.jsonl").find("\"touch\":true") == std::string::npos)
+        << "the daemon reported a touch before libinput was there";
+    daemon.signal(SIGCONT);
+    ASSERT_TRUE(opened) << "libinput debug-events never opened " << devnode;
+
+    // Held again once it has logged the lift, until libinput shows the up: an up that came only with the
+    // device's removal at the end would be a lift the screen missed.
+    constexpr auto kReplayPatience = 300s;  // 108 frames take 25 s under emulation
+    ASSERT_TRUE(
+        waitFor([&] { return logsALift(test::fileContents(dir / "touches.jsonl")) || !daemon.running(); },
+                kReplayPatience));
+    daemon.signal(SIGSTOP);
+    ASSERT_TRUE(daemon.running()) << "the replay ended before its lift could be checked\n" << daemon.output();
+    EXPECT_TRUE(waitFor([&] {
+        return test::fileContents(dir / "libinput.txt").find("TOUCH_UP") != std::string::npos;
+    })) << "libinput showed no up after the daemon's lift:\n"
+        << test::fileContents(dir / "libinput.txt");
+    daemon.signal(SIGCONT);
+
+    // The daemon ends with the recording and takes its touchscreen along.
+    const std::optional<int> status = daemon.wait(kReplayPatience);
+    ASSERT_TRUE(status) << "the replay did not end\n" << daemon.output();
+    EXPECT_EQ(*status, 0) << daemon.output();
+    EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); }));
+    std::this_thread::sleep_for(300ms);
+    libinput.signal(SIGINT);
+    EXPECT_TRUE(libinput.wait(kPatience)) << "libinput debug-events did not stop";
+    const std::string libinputOutput = test::fileContents(dir / "libinput.txt");
+    std::cout << "everytouchd log:\n" << daemon.output() << "libinput debug-events:\n" << libinputOutput;
+
+    const std::vector<io::TouchLogEntry> log = io::readTouchLog(dir / "touches.jsonl");
+    const std::vector<LoggedTouch> logged = loggedTouches(log, axes);
+    const auto downs = static_cast<std::size_t>(
+        std::ranges::count_if(logged, [](const LoggedTouch& t) { return t.begins; }));
+    ASSERT_GE(downs, 1u) << "the daemon detected no touch in " << recordingPath;
+    // A lift the daemon saw, not the release of what still touches when the recording ends.
+    ASSERT_LT(logged.back().entry + 1, log.size());
+    ASSERT_LT(log[logged.back().entry + 1].index, recording.frames().back().index)
+        << "the finger still touched at the end of the recording";
+
+    // Every touch the daemon logged reaches the table where the finger is.
+    double worstLoggedMm = 0.0;
+    for (const LoggedTouch& touch : logged) {
+        const double error =
+            truthDistanceMm(recording, touch.index, expectedMm(calibration, touch.px.x, touch.px.y));
+        worstLoggedMm = std::max(worstLoggedMm, error);
+        EXPECT_LE(error, kTruthToleranceMm) << "touch log, frame " << touch.index;
+    }
+
+    // Each libinput down and motion is a touch of the log, in the log's order, at the position the device
+    // carries: in axis units of 0.01 mm or finer, from the log's position rounded to 0.01 px (under a unit),
+    // printed by libinput to 0.01 mm.
+    const double matchMmX = 1.5 / axes.resolutionX + 0.005, matchMmY = 1.5 / axes.resolutionY + 0.005;
+    const std::vector<LibinputTouch> seen = libinputTouches(libinputOutput);
+    std::map<int, bool> slotDown;
+    std::size_t next = 0, libinputDowns = 0, libinputUps = 0, motions = 0;
+    double worstSeenMm = 0.0;
+    for (size_t i = 0; i < seen.size(); ++i) {
+        const LibinputTouch& touch = seen[i];
+        SCOPED_TRACE("libinput event " + std::to_string(i) + " " + touch.type + " slot " +
+                     std::to_string(touch.slot));
+        if (touch.type == "TOUCH_UP" || touch.type == "TOUCH_CANCEL") {
+            EXPECT_TRUE(slotDown[touch.slot]) << "the slot was not down";
+            slotDown[touch.slot] = false;
+            libinputUps += touch.type == "TOUCH_UP";
+            continue;
+        }
+        const bool down = touch.type == "TOUCH_DOWN";
+        EXPECT_EQ(slotDown[touch.slot], !down);
+        slotDown[touch.slot] = true;
+        libinputDowns += down;
+        motions += !down;
+        std::size_t match = next;
+        while (match < logged.size() &&
+               (logged[match].begins != down || std::abs(logged[match].deviceMm.x - touch.mm.x) > matchMmX ||
+                std::abs(logged[match].deviceMm.y - touch.mm.y) > matchMmY))
+            ++match;
+        ASSERT_LT(match, logged.size())
+            << "no " << (down ? "touch-down" : "touching frame") << " of the daemon's log, from frame "
+            << (next < logged.size() ? logged[next].index : 0) << " on, is at (" << touch.mm.x << ", "
+            << touch.mm.y << ") mm";
+        next = match;
+        const double error = truthDistanceMm(recording, logged[match].index, touch.mm);
+        worstSeenMm = std::max(worstSeenMm, error);
+        EXPECT_LE(error, kTruthToleranceMm) << "frame " << logged[match].index;
+    }
+    EXPECT_EQ(libinputDowns, downs) << libinputOutput;
+    EXPECT_EQ(libinputUps, libinputDowns) << libinputOutput;
+    for (const auto& [slot, isDown] : slotDown)
+        EXPECT_FALSE(isDown) << "slot " << slot << " left down";
+
+    // No move is lost or merged with the next: every logged frame in which the finger moved by more than the
+    // log's rounding shows as a motion of its own, and none shows where the log has no touch.
+    std::size_t moved = 0, touchingFrames = 0;
+    std::map<std::uint32_t, cv::Point2i> lastUnits;
+    for (const LoggedTouch& touch : logged) {
+        if (!touch.begins) {
+            ++touchingFrames;
+            const cv::Point2i step = touch.units - lastUnits[touch.id];
+            moved += std::abs(step.x) >= 2 || std::abs(step.y) >= 2;
+        }
+        lastUnits[touch.id] = touch.units;
+    }
+    std::cout << "libinput: " << libinputDowns << " down, " << motions << " motion, " << libinputUps
+              << " up; the touch log: " << downs << " down, " << touchingFrames
+              << " frames touching after it, " << moved
+              << " of them moving; farthest from the true contact point: libinput " << worstSeenMm
+              << " mm, the touch log " << worstLoggedMm << " mm\n";
+    EXPECT_GE(motions, moved);
+    EXPECT_LE(motions, touchingFrames);
+    EXPECT_GT(moved, 10u) << "the finger hardly moved while touching";
 }
 
 }  // namespace
