@@ -40,6 +40,8 @@ std::optional<std::string> TrackerOptions::validate() const {
         return "betaHzPerMmPerS: must be a non-negative number";
     if (!(derivativeCutoffHz > 0.0) || !std::isfinite(derivativeCutoffHz))
         return "derivativeCutoffHz: must be a positive frequency";
+    if (restingReadings < 2)
+        return "restingReadings: must be at least 2, for a spread";
     if (maxTracks < kMaxContacts)
         return "maxTracks: must be at least " + std::to_string(kMaxContacts) + ", the contacts reported";
     return std::nullopt;
@@ -242,16 +244,39 @@ void ContactTracker::updateTouch(Track& track, const FingerObservation& finger, 
         }
         return;
     }
-    const double liftMm =
-        touchHeightMm + std::max(options_.minHysteresisMm, options_.hysteresisSigmas * sigma);
+    double liftMm = touchHeightMm + std::max(options_.minHysteresisMm, options_.hysteresisSigmas * sigma);
+    double decisiveUpMm = decisiveMm;
+    // Once learned, only readings within the band of the resting level are of the finger at rest: a finger
+    // rising slowly must not carry its level up with it.
+    bool resting = finger.padHeightMm <= liftMm;
+    if (track.resting.count >= options_.restingReadings) {
+        const double bandMm =
+            std::max(options_.minHysteresisMm, options_.hysteresisSigmas * track.resting.spreadMm());
+        liftMm = std::max(touchHeightMm, track.resting.meanMm) + bandMm;
+        decisiveUpMm = std::max(options_.minHysteresisMm, options_.decisiveSigmas * track.resting.spreadMm());
+        resting = finger.padHeightMm <= track.resting.meanMm + bandMm;
+    }
+    if (resting)
+        track.resting.add(finger.padHeightMm);
     const double aboveMm = finger.padHeightMm - liftMm;
     const bool up = aboveMm > 0.0;
-    if (up && (track.pending || aboveMm >= decisiveMm)) {
+    if (up && (track.pending || aboveMm >= decisiveUpMm)) {
         track.touching = false;
         track.pending = false;
     } else {
         track.pending = up;
     }
+}
+
+void ContactTracker::RestingLevel::add(double heightMm) {
+    ++count;
+    const double delta = heightMm - meanMm;
+    meanMm += delta / count;
+    sumSquaresMm2 += delta * (heightMm - meanMm);
+}
+
+double ContactTracker::RestingLevel::spreadMm() const {
+    return count > 1 ? std::sqrt(sumSquaresMm2 / (count - 1)) : 0.0;
 }
 
 }  // namespace everytouch::core

@@ -58,6 +58,13 @@ struct TrackerOptions {
     // standard deviations and by at least minHysteresisMm; otherwise two frames running are needed. A finger
     // hovering just above the touch height dips 4 sigma below it once in 3 * 10^4 frames.
     double decisiveSigmas = 4.0;
+    // Pad heights read while a finger rests, after which the lift is judged against that finger's own
+    // resting level and scatter instead of the observation's uncertainty. The pad height subtracts a prior
+    // thickness, so a thicker finger rests above zero, and the uncertainty must cover every finger's
+    // thickness (about 2 mm): a band three times that let a rising finger pass 8 mm before it lifted. A
+    // finger's own readings at rest measure both its offset and its noise; 8 frames (67 ms at 120 Hz) give
+    // their spread to within a third.
+    int restingReadings = 8;
 
     // The position filter (core/one_euro_filter.h): its cutoff at rest, Hz. At 120 Hz, 1 Hz cuts a resting
     // finger's jitter of positionNoiseMm about fivefold (jitter twice that opens the filter now and then).
@@ -88,7 +95,11 @@ struct TrackerOptions {
 //   keeps two fingers passing each other at speed apart; fingers turning back abruptly within a finger's
 //   width of each other can swap when each moves more than half their gap a frame (0.6 m/s at 10 mm).
 // - Touch, with T the touch height and sigma the frame's height uncertainty: a finger goes down when its pad
-//   height h <= T, and lifts when h > T + max(minHysteresisMm, hysteresisSigmas * sigma).
+//   height h <= T, and lifts when h > T + max(minHysteresisMm, hysteresisSigmas * sigma). Once a touching
+//   finger has given restingReadings heights, it lifts when h > max(T, m) + max(minHysteresisMm,
+//   hysteresisSigmas * s), m and s being the mean and standard deviation of its readings at rest: its own
+//   resting level and its own noise. Readings at rest are those below the lift line while it is learned,
+//   then those within the band above m.
 // - Heights: an observation without a height, or with one further from the track's last than a finger moves
 //   at maxSpeedMmPerS in the time (plus three sigma), keeps its track but changes no touch state; after
 //   maxUnmeasuredFrames such frames running a touching finger lifts, not counting frames whose code still
@@ -132,6 +143,14 @@ public:
 
 private:
     static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min();
+    // Mean and spread of a touching finger's pad height readings (Welford's running sums).
+    struct RestingLevel {
+        int count = 0;
+        double meanMm = 0.0;
+        double sumSquaresMm2 = 0.0;  // of the differences from the mean
+        void add(double heightMm);
+        double spreadMm() const;  // sample standard deviation
+    };
     struct Track {
         std::uint32_t id = 0;
         Eigen::Vector2d observed = Eigen::Vector2d::Zero();  // last observation, display pixels
@@ -143,6 +162,7 @@ private:
         bool touching = false;
         bool palm = false;
         bool pending = false;  // the last observation met the condition for the other touch state, undecided
+        RestingLevel resting;  // the pad heights read while it touched
         OneEuroFilter filter;
     };
 

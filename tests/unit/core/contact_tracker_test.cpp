@@ -123,6 +123,7 @@ TEST(TrackerOptions, DefaultsAreValidAndMistakesAreNamed) {
     EXPECT_THAT(problem([](TrackerOptions& o) { o.hysteresisSigmas = -1; }), StartsWith("hysteresisSigmas:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.decisiveSigmas = INFINITY; }),
                 StartsWith("decisiveSigmas:"));
+    EXPECT_THAT(problem([](TrackerOptions& o) { o.restingReadings = 1; }), StartsWith("restingReadings:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.minCutoffHz = 0; }), StartsWith("minCutoffHz:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.betaHzPerMmPerS = -1; }), StartsWith("betaHzPerMmPerS:"));
     EXPECT_THAT(problem([](TrackerOptions& o) { o.derivativeCutoffHz = 0; }),
@@ -576,6 +577,50 @@ TEST(ContactTracker, ALiftIsReportedAtMostOneFrameLate) {
     const int lifted = static_cast<int>(std::find(states.begin(), states.end(), false) - states.begin());
     EXPECT_GE(lifted, crossed);
     EXPECT_LE(lifted, crossed + 1);
+}
+
+// The pipeline's uncertainty covers every finger's thickness (2 mm, one standard deviation), so the band of
+// three of them would hold a rising finger down to past 9 mm. Resting, a finger's own readings here lie at
+// 0.8 mm with 0.4 mm of noise; rising at 2 mm a frame it lifts at the second frame above 0.8 + 3 + 1.2 mm
+// instead (or at the first decisive one).
+TEST(ContactTracker, ARestedFingerLiftsAgainstItsOwnLevelAndNoise) {
+    constexpr double kPipelineSigmaMm = 2.1;
+    std::mt19937 random(5);
+    std::normal_distribution<double> noise(0.8, 0.4);
+    std::vector<double> heights;
+    for (int f = 0; f < 40; ++f)
+        heights.push_back(noise(random));
+    for (int f = 1; f <= 8; ++f)
+        heights.push_back(0.8 + 2.0 * f);  // 2.8, 4.8, 6.8, ...
+    std::vector<bool> states;
+    Feed feed;
+    EXPECT_EQ(touchChanges(feed, heights, kPipelineSigmaMm, &states), 2);
+    const int lifted = static_cast<int>(std::find(states.begin() + 1, states.end(), false) - states.begin());
+    EXPECT_EQ(heights[lifted], 6.8) << "lifted at frame " << lifted;
+
+    // Before it has rested long enough to tell, the pipeline's uncertainty rules: the band is 6.3 mm.
+    TrackerOptions unlearned;
+    unlearned.restingReadings = 100;
+    Feed early(unlearned);
+    states.clear();
+    touchChanges(early, heights, kPipelineSigmaMm, &states);
+    const int liftedEarly =
+        static_cast<int>(std::find(states.begin() + 1, states.end(), false) - states.begin());
+    EXPECT_GT(heights[liftedEarly], 3.0 + 3.0 * kPipelineSigmaMm);
+}
+
+// A finger resting with noisy readings stays down for a minute at 120 Hz: its band follows its noise.
+TEST(ContactTracker, ARestingFingerWithItsOwnNoiseDoesNotLift) {
+    for (unsigned seed = 1; seed <= 4; ++seed) {
+        std::mt19937 random(seed);
+        std::normal_distribution<double> noise(1.5, 1.0);
+        std::vector<double> heights;
+        for (int f = 0; f < 7200; ++f)
+            heights.push_back(std::max(0.0, noise(random)));
+        heights[0] = 0.0;
+        Feed feed;
+        EXPECT_EQ(touchChanges(feed, heights, 2.2), 1) << "seed " << seed;
+    }
 }
 
 TEST(ContactTracker, JitterOfARestingFingerIsCutThreefold) {
