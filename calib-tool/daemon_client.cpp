@@ -119,6 +119,28 @@ std::variant<std::map<std::string, PropertyValue>, Failure> DaemonClient::allPro
     return properties;
 }
 
+std::variant<DaemonClient::Display, Failure> DaemonClient::display() {
+    Display display;
+    io::UniqueBusError error;
+    sd_bus_message* raw = nullptr;
+    int r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "DisplaySize",
+                                error.get(), &raw, "(uu)");
+    io::BusMessage size(raw);
+    if (r >= 0)
+        r = sd_bus_message_read(size.get(), "(uu)", &display.widthPx, &display.heightPx);
+    if (r >= 0) {
+        raw = nullptr;
+        r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "DisplaySizeMm",
+                                error.get(), &raw, "(dd)");
+        size.reset(raw);
+    }
+    if (r >= 0)
+        r = sd_bus_message_read(size.get(), "(dd)", &display.widthMm, &display.heightMm);
+    if (r < 0)
+        return explain(error, r, "Reading the display's size");
+    return display;
+}
+
 std::optional<Failure> DaemonClient::setTouchHeightMm(double heightMm) {
     io::UniqueBusError error;
     const int r = sd_bus_set_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
@@ -436,24 +458,25 @@ std::optional<Failure> DaemonClient::followContacts(const ContactsOptions& optio
     // Hands over what the callbacks recorded, here and not inside them, so that the handler may throw.
     ContactsUpdate update;
     update.frameRate = follower.frameRate;
-    onUpdate(update);
-    while (true) {
+    bool following = onUpdate(update);
+    while (following) {
         for (ContactsFollower::Received& received : follower.received) {
             update.seconds = received.seconds;
             update.contactsChanged = true;
             update.contacts = std::move(received.contacts);
             update.frameRate = follower.frameRate;
-            onUpdate(update);
+            if (!(following = onUpdate(update)))
+                break;
         }
         follower.received.clear();
-        if (follower.frameRateRead) {
+        if (following && follower.frameRateRead) {
             follower.frameRateRead = false;
             update.seconds = follower.secondsSinceStart();
             update.contactsChanged = false;
             update.frameRate = follower.frameRate;
-            onUpdate(update);
+            following = onUpdate(update);
         }
-        if (follower.end != ContactsFollower::End::None)
+        if (!following || follower.end != ContactsFollower::End::None)
             break;
         r = sd_event_run(event.get(), UINT64_MAX);
         if (r < 0)

@@ -46,6 +46,15 @@ public:
     static std::variant<DaemonClient, Failure> connect();
 
     std::variant<std::map<std::string, PropertyValue>, Failure> allProperties();
+
+    // The display the touches are reported in, from the active calibration; zero while not calibrated.
+    struct Display {
+        std::uint32_t widthPx = 0;
+        std::uint32_t heightPx = 0;
+        double widthMm = 0.0;  // on the table
+        double heightMm = 0.0;
+    };
+    std::variant<Display, Failure> display();
     std::optional<Failure> setTouchHeightMm(double heightMm);
     std::optional<Failure> snapshot(const std::string& what, int fd);
     std::optional<Failure> saveCalibration();
@@ -80,9 +89,11 @@ public:
         std::vector<ContactReading> contacts;
         double frameRate = 0.0;  // frames per second, read once a second
     };
-    using ContactsHandler = std::function<void(const ContactsUpdate& update)>;
-    // Follows the Contacts signal until `options` are met or SIGINT or SIGTERM arrives (then nothing is
-    // returned), or until the daemon leaves the bus (a Failure). `onUpdate` runs outside sd-bus callbacks.
+    // Returns false to stop following.
+    using ContactsHandler = std::function<bool(const ContactsUpdate& update)>;
+    // Follows the Contacts signal until `options` are met, `onUpdate` returns false or SIGINT or SIGTERM
+    // arrives (then nothing is returned), or until the daemon leaves the bus (a Failure). `onUpdate` runs
+    // outside sd-bus callbacks.
     std::optional<Failure> followContacts(const ContactsOptions& options, const ContactsHandler& onUpdate);
 
 private:

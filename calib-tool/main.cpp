@@ -5,19 +5,25 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "accuracy_report.h"
+#include "accuracy_rig.h"
 #include "contacts_view.h"
 #include "daemon_client.h"
 #include "io/handles.h"
+#include "tap_scoring.h"
 #include "version.h"
 
 namespace {
@@ -172,8 +178,87 @@ int monitor(const DaemonClient::ContactsOptions& options) {
         return report(*failure);
     calib::ContactsView view(stdout, ::isatty(STDOUT_FILENO));
     if (auto failure = std::get<DaemonClient>(client).followContacts(
-            options, [&view](const DaemonClient::ContactsUpdate& update) { view.show(update); }))
+            options, [&view](const DaemonClient::ContactsUpdate& update) {
+                view.show(update);
+                return true;
+            }))
         return report(*failure);
+    return calib::kExitOk;
+}
+
+std::string textProperty(const std::map<std::string, calib::PropertyValue>& properties, const char* name) {
+    const auto it = properties.find(name);
+    const std::string* text = it != properties.end() ? std::get_if<std::string>(&it->second) : nullptr;
+    return text ? *text : std::string();
+}
+
+// The paper's accuracy test: a tap on each of the 35 circles, scored as it scores its trials.
+int accuracyTest(double timeoutS, const std::optional<std::filesystem::path>& jsonFile) {
+    auto client = DaemonClient::connect();
+    if (auto* failure = std::get_if<Failure>(&client))
+        return report(*failure);
+    DaemonClient& daemon = std::get<DaemonClient>(client);
+    auto properties = daemon.allProperties();
+    if (auto* failure = std::get_if<Failure>(&properties))
+        return report(*failure);
+    const std::string rig = textProperty(std::get<0>(properties), "Rig");
+    if (const std::optional<std::string> problem = calib::accuracyTestRigProblem(rig))
+        return report({calib::kExitFailure, *problem + "."});
+    if (const std::string state = textProperty(std::get<0>(properties), "State"); state != "running")
+        return report({calib::kExitFailure, "everytouchd is not detecting touches (it is " + state +
+                                                "); \"everytouch-calib status\" shows why."});
+    auto display = daemon.display();
+    if (auto* failure = std::get_if<Failure>(&display))
+        return report(*failure);
+
+    calib::AccuracyRun run;
+    run.rig = rig;
+    run.display = std::get<DaemonClient::Display>(display);
+    run.targets = calib::accuracyTargets(run.display);
+    run.timeoutS = timeoutS;
+    if (run.display.widthPx == 0 || run.display.heightPx == 0 || !(run.display.widthMm > 0.0) ||
+        !(run.display.heightMm > 0.0))
+        return report(
+            {calib::kExitFailure,
+             "everytouchd knows no display: it is not calibrated. Run \"everytouch-calib calibrate\" "
+             "first."});
+    run.score = calib::scoreTaps(run.targets, {});
+    std::fprintf(
+        stderr,
+        "Waiting for a tap on each of the %zu circles (the simulated hand taps them), at most %g s.\n",
+        run.targets.centres.size(), timeoutS);
+
+    calib::TouchDownFinder finder;
+    std::vector<calib::TouchDown> touchDowns;
+    DaemonClient::ContactsOptions options;
+    options.durationS = timeoutS;
+    const auto started = std::chrono::steady_clock::now();
+    const std::optional<Failure> failure =
+        daemon.followContacts(options, [&](const DaemonClient::ContactsUpdate& update) {
+            if (!update.contactsChanged)
+                return true;
+            for (const calib::TouchDown& touchDown : finder.next(update.seconds, update.contacts)) {
+                touchDowns.push_back(touchDown);
+                const calib::TapScore before = std::move(run.score);
+                run.score = calib::scoreTaps(run.targets, touchDowns);
+                for (std::size_t i = 0; i < run.score.circles.size(); ++i)
+                    if (run.score.circles[i].tap && !before.circles[i].tap)
+                        std::fprintf(stderr, "%s\n", calib::describeTap(run, i).c_str());
+            }
+            return !run.score.complete();
+        });
+    run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (failure)
+        return report(*failure);
+
+    calib::printAccuracyReport(stdout, run);
+    if (jsonFile) {
+        std::ofstream out(*jsonFile);
+        out << calib::accuracyReportJson(run).dump(2) << "\n";
+        out.close();
+        if (!out)
+            return report({calib::kExitFailure, "Cannot write " + jsonFile->string() + "."});
+    }
     return calib::kExitOk;
 }
 
@@ -238,6 +323,22 @@ int main(int argc, char** argv) {
     monitorCommand->add_option("--duration", monitorOptions.durationS, "End after S seconds")
         ->check(CLI::Range(0.001, 1e9));
 
+    // The simulated session taps all 35 circles in 53 s where the simulator keeps real time; one started
+    // mid-session completes on the hand's next round, and a slower machine takes longer.
+    double timeoutS = 300.0;
+    std::optional<std::filesystem::path> jsonFile;
+    CLI::App* testCommand =
+        app.add_subcommand("test",
+                           "The paper's accuracy test: one tap on each of 35 circles, scored as epsilon "
+                           "(display px and mm), FRR and FAR; in this build on the simulated rig only "
+                           "(everytouchd --rig sim:grid35)");
+    testCommand
+        ->add_option("--timeout-s", timeoutS, "Stop after S seconds even when some circles have no tap")
+        ->check(CLI::Range(0.001, 1e9))
+        ->capture_default_str();
+    testCommand->add_option("--json", jsonFile,
+                            "Also write every circle's tap and the scores to FILE as JSON");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {
@@ -254,5 +355,7 @@ int main(int argc, char** argv) {
         return snapshot(what, file);
     if (monitorCommand->parsed())
         return monitor(monitorOptions);
+    if (testCommand->parsed())
+        return accuracyTest(timeoutS, jsonFile);
     return calib::kExitUsage;
 }

@@ -99,6 +99,26 @@ int getCalibrated(sd_bus*, const char*, const char*, const char*, sd_bus_message
     return sd_bus_message_append(reply, "b", static_cast<int>(serviceOf(userdata).daemon().calibrated()));
 }
 
+// The display the touches are reported in, pixels; (0, 0) when not calibrated.
+int getDisplaySize(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                   sd_bus_error*) noexcept {
+    const std::optional<core::Calibration>& calibration = serviceOf(userdata).daemon().activeCalibration();
+    const cv::Size size = calibration ? calibration->displaySize : cv::Size();
+    return sd_bus_message_append(reply, "(uu)", static_cast<std::uint32_t>(size.width),
+                                 static_cast<std::uint32_t>(size.height));
+}
+
+// The display's width and height on the table, mm (the mean of opposite sides); (0, 0) when not calibrated.
+int getDisplaySizeMm(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                     sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        const std::optional<core::Calibration>& calibration =
+            serviceOf(userdata).daemon().activeCalibration();
+        const cv::Size2d sizeMm = calibration ? calibration->displaySizeMm() : cv::Size2d();
+        return sd_bus_message_append(reply, "(dd)", sizeMm.width, sizeMm.height);
+    });
+}
+
 int getFrameRate(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
                  sd_bus_error*) noexcept {
     return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().statistics().frameRate);
@@ -195,6 +215,8 @@ const sd_bus_vtable kVtable[] = {
     SD_BUS_PROPERTY("Rig", "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY("Calibrated", "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     // Statistics change with every frame: clients poll them instead of being flooded with signals.
+    SD_BUS_PROPERTY("DisplaySize", "(uu)", getDisplaySize, 0, 0),
+    SD_BUS_PROPERTY("DisplaySizeMm", "(dd)", getDisplaySizeMm, 0, 0),
     SD_BUS_PROPERTY("FrameRate", "d", getFrameRate, 0, 0),
     SD_BUS_PROPERTY("LatencyMs", "d", getLatencyMs, 0, 0),
     SD_BUS_PROPERTY("DroppedFrames", "t", getDroppedFrames, 0, 0),

@@ -292,6 +292,11 @@ core::PipelineSettings Daemon::pipelineSettings() const {
     return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_, calibration_ == nullptr};
 }
 
+const std::optional<core::Calibration>& Daemon::activeCalibration() const {
+    static const std::optional<core::Calibration> none;
+    return store_ ? store_->active() : none;
+}
+
 LoopStatistics Daemon::statistics() const {
     return loop_ ? loop_->statistics() : LoopStatistics{};
 }

@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/accuracy_grid.h"
+
 namespace everytouch::sim {
 
 namespace {
@@ -225,9 +227,8 @@ std::string contentKindName(ContentKind kind) {
 
 std::vector<cv::Point2d> grid35Centres(cv::Size size) {
     std::vector<cv::Point2d> centres;
-    for (int row = 0; row < 5; ++row)
-        for (int column = 0; column < 7; ++column)
-            centres.emplace_back(size.width * (column + 1) / 8.0, size.height * (row + 1) / 6.0);
+    for (const core::DisplayPoint& centre : core::accuracyGridCentres(size.width, size.height))
+        centres.emplace_back(centre.x, centre.y);
     return centres;
 }
 
@@ -263,7 +264,8 @@ cv::Mat renderContent(ContentKind kind, cv::Size size, std::uint64_t seed, int v
     switch (kind) {
         case ContentKind::Grid35: {
             cv::Mat image(size, CV_8UC3, cv::Scalar(245, 245, 245));
-            const int radius = static_cast<int>(std::lround(std::min(size.width, size.height) * 0.045));
+            const int radius =
+                static_cast<int>(std::lround(core::accuracyGridCircleRadius(size.width, size.height)));
             for (const cv::Point2d& centre : grid35Centres(size)) {
                 const cv::Point c(static_cast<int>(std::lround(centre.x)),
                                   static_cast<int>(std::lround(centre.y)));

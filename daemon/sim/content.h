@@ -28,7 +28,8 @@ std::string contentKindName(ContentKind kind);
 // kind (photo, ui, text), together with `seed`.
 cv::Mat renderContent(ContentKind kind, cv::Size displaySize, std::uint64_t seed, int variant);
 
-// Centres of the 35 circles of Grid35 (7 columns x 5 rows, row by row), display pixels.
+// Centres of the 35 circles of Grid35 (7 columns x 5 rows, row by row), display pixels: those of
+// core/accuracy_grid.h, which everytouch-calib scores taps against.
 std::vector<cv::Point2d> grid35Centres(cv::Size displaySize);
 
 // Outlines of the Shapes content, each a closed polyline in display pixels, in the order square, right

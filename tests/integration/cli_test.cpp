@@ -145,6 +145,23 @@ TEST(EverytouchCalib, MonitorRefusesACountOrDurationOfNothingAsUsage) {
     }
 }
 
+TEST(EverytouchCalib, TestHelpNamesItsOptionsAndTheRigItNeeds) {
+    const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "test", "--help"});
+    EXPECT_EQ(result.exitCode, 0);
+    EXPECT_THAT(result.out, HasSubstr("--timeout-s"));
+    EXPECT_THAT(result.out, HasSubstr("--json"));
+    EXPECT_THAT(result.out, HasSubstr("sim:grid35"));
+}
+
+TEST(EverytouchCalib, TestRefusesATimeoutOfNothingAsUsage) {
+    for (const char* seconds : {"0", "-5"}) {
+        const test::ProcessResult result =
+            test::runProcess({EVERYTOUCH_CALIB_PATH, "test", "--timeout-s", seconds});
+        EXPECT_EQ(result.exitCode, 2) << seconds;
+        EXPECT_THAT(result.err, HasSubstr("--timeout-s")) << seconds;
+    }
+}
+
 TEST(EverytouchCalib, VersionPrintsNameAndVersion) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "--version"});
     EXPECT_EQ(result.exitCode, 0);
