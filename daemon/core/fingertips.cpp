@@ -179,6 +179,8 @@ std::optional<std::string> FingertipOptions::validate() const {
         return "fingertips min_width_ratio, max_width_ratio: need 0 < min < max";
     if (!(minRegionWidths2 >= 0.0))
         return "fingertips min_region_widths2: must not be negative";
+    if (!(minCutRegionWidths2 >= 0.0 && minCutRegionWidths2 <= minRegionWidths2))
+        return "fingertips min_cut_region_widths2: must be in [0, min_region_widths2]";
     if (!(edgeMarginWidths >= 0.0 && edgeMarginWidths <= 2.0))
         return "fingertips edge_margin_widths: must be in [0, 2]";
     if (maxFingertips < 0)
@@ -219,7 +221,7 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
     fingertips.clear();
     scratch.found.clear();
     const double width = options.fingerWidthPx;
-    findOuterContours(handMask, options.minRegionWidths2 * width * width, scratch.contours);
+    findOuterContours(handMask, options.minCutRegionWidths2 * width * width, scratch.contours);
 
     const double step = options.stepWidths * width;
     const double gap = options.groupGapWidths * width;
@@ -253,16 +255,21 @@ void findFingertips(const cv::Mat& handMask, const FingertipOptions& options, Fi
             scratch.arc[i] = scratch.arc[i - 1] + cv::norm(points[i] - points[i - 1]);
         const Contour contour(points, n, scratch.arc,
                               scratch.arc[n - 1] + cv::norm(points[0] - points[n - 1]));
-        if (contour.length() < 4.0 * step)
-            continue;
         // Where the region leaves what is known: the outward normal of the edges it runs along, weighted by
         // how far. A hand reaches into the image from its forearm, so this is the way back to the wrist.
         int armwardX = 0, armwardY = 0;
+        bool cut = false;
         for (int i = 0; i < n; ++i) {
             const cv::Point out = outward(points[i]);
             armwardX += out.x;
             armwardY += out.y;
+            cut = cut || out != cv::Point(0, 0);
         }
+        // A whole region needs the contour of a finger and some of its hand; a cut one only what the angle
+        // test reaches from a tip, a step either way.
+        if (cut ? contour.length() < 2.0 * step
+                : contour.length() < 4.0 * step || span.area < options.minRegionWidths2 * width * width)
+            continue;
         Eigen::Vector2d armward(armwardX, armwardY);
         if (armward.norm() > 0.0)
             armward.normalize();

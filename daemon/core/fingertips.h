@@ -62,6 +62,10 @@ struct FingertipOptions {
     // Regions smaller than this many finger widths squared are not searched: a lone finger seen from above
     // covers several (a finger's tip alone is about one).
     double minRegionWidths2 = 2.0;
+    // The same for a region the edge of the image or of the judged region cuts: only the part of a finger
+    // within it shows, and a fingertip touching near that edge (a button at the display's near side) shows
+    // its end alone, about one finger width squared.
+    double minCutRegionWidths2 = 1.0;
     // A tip pointing within this angle of the way back out of the image where its region's forearm enters
     // is dropped, radians. Fingers point away from the wrist; what seems to point back towards the arm is a
     // thumb raised towards the camera, whose image the parallax pulls back over the hand. Fingers on or near

@@ -266,6 +266,25 @@ TEST(Fingertips, ACornerRoundedOffNearTheJudgedEdgeIsNoFingertip) {
     expectFound(found, scene.finger, 0);
 }
 
+TEST(Fingertips, AFingerTouchingNearTheJudgedEdgeShowsItsEndAlone) {
+    // A button at the display's near side: the hand stays outside the display, the finger reaches in by
+    // 1.6-2 widths, and only that end is judged. A speck of that size inside the display is no finger.
+    for (const double reach : {1.6, 2.0}) {
+        ArmLeavingTheDisplay scene(-90);
+        const Capsule finger{{300, 60}, {300, 100 + reach * kWidth - 9}, 9};
+        scene.mask.setTo(0);
+        fillEllipse(scene.mask, {300, 40}, 40, 32);
+        fillCapsule(scene.mask, finger);
+        scene.mask.setTo(0, scene.judged == 0);
+        fillEllipse(scene.mask, {450, 300}, 10, 18);  // 1.4 widths squared, inside
+        FingertipScratch scratch;
+        Fingertips found;
+        findFingertips(scene.mask, drawnOptions(), scratch, found, scene.judged);
+        ASSERT_EQ(found.size(), 1u) << "reaching in " << reach << " widths" << describe(found);
+        expectFound(found, finger, 0);
+    }
+}
+
 TEST(Fingertips, AllocateNothingOnceWarm) {
     cv::Mat twoHands = cv::Mat::zeros(488, 648, CV_8UC1), oneHand = cv::Mat::zeros(488, 648, CV_8UC1);
     drawHand(twoHands, {180, 140}, true);
