@@ -1,15 +1,10 @@
 #include "accuracy_report.h"
 
+#include "text_format.h"
+
 namespace everytouch::calib {
 
 namespace {
-
-template <typename... Values>
-std::string format(const char* pattern, Values... values) {
-    char text[256];
-    std::snprintf(text, sizeof text, pattern, values...);
-    return text;
-}
 
 std::string point(const core::DisplayPoint& p) {
     return format("(%.1f, %.1f)", p.x, p.y);

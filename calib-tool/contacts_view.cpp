@@ -2,16 +2,11 @@
 
 #include <string>
 
+#include "text_format.h"
+
 namespace everytouch::calib {
 
 namespace {
-
-template <typename... Values>
-std::string format(const char* pattern, Values... values) {
-    char text[128];
-    std::snprintf(text, sizeof text, pattern, values...);
-    return text;
-}
 
 std::string countOf(std::size_t contacts) {
     return std::to_string(contacts) + (contacts == 1 ? " contact" : " contacts");

@@ -24,6 +24,7 @@
 #include "daemon_client.h"
 #include "io/handles.h"
 #include "tap_scoring.h"
+#include "text_format.h"
 #include "version.h"
 
 namespace {
@@ -37,13 +38,6 @@ int report(const Failure& failure) {
     return failure.exitStatus;
 }
 
-template <typename T>
-std::string format(const char* pattern, T value) {
-    char text[64];
-    std::snprintf(text, sizeof text, pattern, value);
-    return text;
-}
-
 // One line per property, in words.
 std::string describe(const std::string& name, const calib::PropertyValue& value) {
     if (const auto* text = std::get_if<std::string>(&value))
@@ -52,10 +46,10 @@ std::string describe(const std::string& name, const calib::PropertyValue& value)
         return *flag ? "yes" : "no";
     if (const auto* number = std::get_if<double>(&value)) {
         if (name == "FrameRate")
-            return format("%.1f frames/s", *number);
+            return calib::format("%.1f frames/s", *number);
         if (name == "LatencyMs")
-            return format("%.1f ms", *number);
-        return format("%.1f mm", *number);
+            return calib::format("%.1f ms", *number);
+        return calib::format("%.1f mm", *number);
     }
     if (const auto* count = std::get_if<std::uint64_t>(&value))
         return std::to_string(*count) + " frames";

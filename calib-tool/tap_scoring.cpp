@@ -39,23 +39,13 @@ bool TapScore::complete() const {
     return tapped() == static_cast<std::int64_t>(circles.size());
 }
 
-std::optional<double> TapScore::epsilonPx() const {
+std::optional<double> TapScore::meanOverTapped(double CircleOutcome::*error) const {
     const std::int64_t count = tapped();
     if (count == 0)
         return std::nullopt;
     double sum = 0.0;
     for (const CircleOutcome& circle : circles)
-        sum += circle.tap ? circle.errorPx : 0.0;
-    return sum / static_cast<double>(count);
-}
-
-std::optional<double> TapScore::epsilonMm() const {
-    const std::int64_t count = tapped();
-    if (count == 0)
-        return std::nullopt;
-    double sum = 0.0;
-    for (const CircleOutcome& circle : circles)
-        sum += circle.tap ? circle.errorMm : 0.0;
+        sum += circle.tap ? circle.*error : 0.0;
     return sum / static_cast<double>(count);
 }
 

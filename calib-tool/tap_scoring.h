@@ -66,11 +66,15 @@ struct TapScore {
     std::int64_t repeats = 0;
 
     std::int64_t tapped() const;
-    bool complete() const;                    // every circle has its tap
-    std::optional<double> epsilonPx() const;  // mean error over the tapped circles; none before a tap
-    std::optional<double> epsilonMm() const;
+    bool complete() const;  // every circle has its tap
+    // Mean error over the tapped circles; none before a tap.
+    std::optional<double> epsilonPx() const { return meanOverTapped(&CircleOutcome::errorPx); }
+    std::optional<double> epsilonMm() const { return meanOverTapped(&CircleOutcome::errorMm); }
     double frr() const;  // circles without a tap / circles
     double far() const;  // false touch-downs / circles
+
+private:
+    std::optional<double> meanOverTapped(double CircleOutcome::*error) const;
 };
 
 // Each touch-down, in the order given, goes to the nearest circle whose radius holds it: the first on a

@@ -67,10 +67,10 @@ public:
     // What the bus shows. Main thread only, like everything below.
     DaemonState state() const;
     const std::string& rig() const { return rigName_; }
-    bool calibrated() const { return store_ && store_->active().has_value(); }
     // The active calibration, where the display's size and its size on the table come from; none when not
     // calibrated.
     const std::optional<core::Calibration>& activeCalibration() const;
+    bool calibrated() const { return activeCalibration().has_value(); }
     LoopStatistics statistics() const;
     double touchHeightMm() const { return touchHeightMm_; }
     const std::string& devicePath() const { return devicePath_; }
