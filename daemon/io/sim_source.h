@@ -27,6 +27,8 @@ public:
     std::optional<core::Frame> next() override;
     std::optional<RigDescription> rig() const override;
     std::string describe() const override;
+    // Without duration= the stream has no end.
+    bool endless() const { return !simulator_->endFrame(); }
     std::optional<std::vector<core::FingerTruth>> truth() const override;
     // The renderer's mask itself, rewritten by the next frame.
     std::optional<cv::Mat> truthMask() const override { return truth_.handMask; }

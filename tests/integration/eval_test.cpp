@@ -221,6 +221,40 @@ TEST_F(EvaluateTouches, ScoresThePipelineAndItsTouchLogAlike) {
     EXPECT_EQ(logged["rejected"], direct["rejected"]);
 }
 
+TEST_F(EvaluateTouches, ScoresTheSimulatedRigLiveAsItsRecording) {
+    const nlohmann::json recorded = score({}, scratch("recorded.json"));
+    const std::filesystem::path json = scratch("live.json");
+    const test::ProcessResult result = test::runProcess(
+        {EVERYTOUCH_EVAL_PATH, "touches", "--rig", "sim:grid35", "--frames", "240", "--json", json.string()});
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_THAT(result.out, HasSubstr("sim:grid35: 240 frames"));
+    const nlohmann::json live = nlohmann::json::parse(test::fileContents(json));
+    for (const char* field : {"frames", "trials", "touch_downs", "rejected", "high_hover_touch_frames"})
+        EXPECT_EQ(live[field], recorded[field]) << field;
+    ASSERT_EQ(live["per_trial"].size(), recorded["per_trial"].size());
+    for (std::size_t i = 0; i < live["per_trial"].size(); ++i) {
+        const nlohmann::json &a = live["per_trial"][i], &b = recorded["per_trial"][i];
+        for (const char* field : {"finger", "first", "last", "found", "latency_frames"})
+            EXPECT_EQ(a[field], b[field]) << "trial " << i << " " << field;
+        // truth.csv keeps a millimetre's thousandth of a display pixel; the rig itself keeps all digits.
+        EXPECT_NEAR(a["error_px"].get<double>(), b["error_px"].get<double>(), 0.01) << "trial " << i;
+    }
+}
+
+TEST(EverytouchEval, TouchesOnARigNeedsAnEndAndTheSimulatedRig) {
+    const test::ProcessResult endless =
+        test::runProcess({EVERYTOUCH_EVAL_PATH, "touches", "--rig", "sim:grid35"});
+    EXPECT_EQ(endless.exitCode, 2);
+    EXPECT_THAT(endless.err, HasSubstr("--frames"));
+    const test::ProcessResult replay =
+        test::runProcess({EVERYTOUCH_EVAL_PATH, "touches", "--rig", "replay:/nonexistent", "--frames", "9"});
+    EXPECT_EQ(replay.exitCode, 2);
+    EXPECT_THAT(replay.err, HasSubstr("only the simulated rig"));
+    const test::ProcessResult neither = test::runProcess({EVERYTOUCH_EVAL_PATH, "touches"});
+    EXPECT_EQ(neither.exitCode, 2);
+    EXPECT_THAT(neither.err, HasSubstr("--rig"));
+}
+
 TEST_F(EvaluateTouches, RefusesALogOfAnotherRecordingNamingTheLine) {
     const std::filesystem::path log = scratch("foreign.jsonl");
     {

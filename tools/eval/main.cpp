@@ -18,12 +18,15 @@
 #include "eval/segmentation_evaluation.h"
 #include "eval/segmentation_methods.h"
 #include "eval/segmentation_report.h"
+#include "eval/source_run.h"
 #include "eval/touch_plot.h"
 #include "eval/touch_report.h"
 #include "eval/touch_scoring.h"
 #include "eval/touch_trials.h"
 #include "io/input_error.h"
 #include "io/recording.h"
+#include "io/rig_spec.h"
+#include "io/sim_source.h"
 #include "io/touch_log.h"
 #include "version.h"
 
@@ -161,6 +164,8 @@ int runSegmentation(const SegmentationArguments& arguments) {
 struct TouchArguments {
     std::string recording;
     std::string log;  // empty: run the pipeline on the recording
+    std::string rig;  // instead of a recording: a simulated rig, run live
+    std::size_t frames = 0;
     std::string json;
     std::string png;
     // The match radius, mm: half a finger width (an adult index finger is about 16 mm across), the distance
@@ -177,10 +182,23 @@ CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
         "touches",
         "Score detected touches against truth.csv: FRR and FAR per tap trial, touch point error epsilon, "
         "touch-down latency, drag deviation, id swaps, hover height error");
-    command->add_option("REC", arguments.recording, "Recording directory with truth.csv")->required();
-    command->add_option("LOG", arguments.log,
-                        "Touch log made from REC (everytouchd --rig replay:REC --log LOG); without it the "
-                        "pipeline runs on REC");
+    CLI::Option* recording =
+        command->add_option("REC", arguments.recording, "Recording directory with truth.csv");
+    command
+        ->add_option("LOG", arguments.log,
+                     "Touch log made from REC (everytouchd --rig replay:REC --log LOG); without it the "
+                     "pipeline runs on REC")
+        ->needs(recording);
+    CLI::Option* rig = command->add_option(
+        "--rig", arguments.rig,
+        "Instead of REC, run the pipeline live on a simulated rig, sim[:SCENARIO][,key=value...] as "
+        "everytouchd takes it, without recording its frames");
+    command
+        ->add_option("--frames", arguments.frames,
+                     "With --rig: frames to run (the rig's own duration= otherwise)")
+        ->needs(rig)
+        ->check(CLI::PositiveNumber);
+    recording->excludes(rig);
     command->add_option("--json", arguments.json, "Also write the results as JSON to FILE");
     command->add_option("--png", arguments.png,
                         "Plot true (green) and detected (red) touch-down points over the display");
@@ -217,7 +235,54 @@ CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
     return command;
 }
 
+// Scores detected contacts against the truth and prints (and writes) the results. rigName: where `rig` was
+// read, for a message.
+int reportTouches(const TouchArguments& arguments, const std::string& sourceName, const std::string& rigName,
+                  const io::RigDescription& rig, const eval::TruthFrames& truth,
+                  const eval::DetectedFrames& detected) {
+    eval::TouchScoringOptions options;
+    options.matchRadiusPx = eval::matchRadiusPx(rig.calibration, arguments.matchRadiusMm);
+    options.highHoverMm = arguments.highHoverMm;
+    options.touchHeightMm = arguments.touchHeightMm;
+    if (const auto problem = options.validate())
+        throw io::InputError(rigName, "", *problem);
+    const eval::TouchScore score = eval::scoreTouches(truth, detected, options);
+    const eval::TouchSource source{sourceName, arguments.log, arguments.matchRadiusMm, rig.frameRate};
+    std::fputs(eval::touchTable(source, score).c_str(), stdout);
+
+    if (!arguments.json.empty()) {
+        std::ofstream out(arguments.json);
+        out << eval::touchJson(source, score).dump(2) << '\n';
+        if (!out)
+            throw std::runtime_error(arguments.json + ": cannot be written");
+    }
+    if (!arguments.png.empty() &&
+        !cv::imwrite(arguments.png, eval::plotTouchDowns(score, rig.calibration.displaySize)))
+        throw std::runtime_error(arguments.png + ": cannot be written");
+    return 0;
+}
+
+int runTouchesOnRig(const TouchArguments& arguments) {
+    const io::RigSpec spec = io::RigSpec::parse(arguments.rig);
+    if (spec.kind != io::RigSpec::Kind::Sim)
+        throw io::InputError("--rig " + arguments.rig, "",
+                             "only the simulated rig knows the truth to score against; score a recording as "
+                             "REC instead");
+    io::SimSource source(spec, /*paced=*/false);
+    if (arguments.frames == 0 && source.endless())
+        throw io::InputError("--rig " + arguments.rig, "",
+                             "runs without end; give --frames N or duration=SECONDS in the spec");
+    const eval::SourceRun run = eval::runOnSource(source, "--rig " + arguments.rig, arguments.frames,
+                                                  core::DetectionOptions{}, arguments.touchHeightMm);
+    return reportTouches(arguments, arguments.rig, "--rig " + arguments.rig, run.rig, run.truth,
+                         run.detected);
+}
+
 int runTouches(const TouchArguments& arguments) {
+    if (!arguments.rig.empty())
+        return runTouchesOnRig(arguments);
+    if (arguments.recording.empty())
+        throw io::InputError("touches", "", "give a recording REC or a simulated rig with --rig");
     const io::Recording recording = io::Recording::open(arguments.recording);
     if (!recording.hasTruth())
         throw io::InputError(arguments.recording, "truth.csv",
@@ -228,28 +293,8 @@ int runTouches(const TouchArguments& arguments) {
         detected = eval::contactsFromPipeline(recording, core::DetectionOptions{}, arguments.touchHeightMm);
     else
         detected = eval::contactsFromLog(recording, io::readTouchLog(arguments.log), arguments.log);
-
-    eval::TouchScoringOptions options;
-    options.matchRadiusPx = eval::matchRadiusPx(recording.rig().calibration, arguments.matchRadiusMm);
-    options.highHoverMm = arguments.highHoverMm;
-    options.touchHeightMm = arguments.touchHeightMm;
-    if (const auto problem = options.validate())
-        throw io::InputError(arguments.recording + "/rig.yml", "", *problem);
-    const eval::TouchScore score = eval::scoreTouches(eval::truthFrames(recording), detected, options);
-    const eval::TouchSource source{arguments.recording, arguments.log, arguments.matchRadiusMm,
-                                   recording.rig().frameRate};
-    std::fputs(eval::touchTable(source, score).c_str(), stdout);
-
-    if (!arguments.json.empty()) {
-        std::ofstream out(arguments.json);
-        out << eval::touchJson(source, score).dump(2) << '\n';
-        if (!out)
-            throw std::runtime_error(arguments.json + ": cannot be written");
-    }
-    if (!arguments.png.empty() &&
-        !cv::imwrite(arguments.png, eval::plotTouchDowns(score, recording.rig().calibration.displaySize)))
-        throw std::runtime_error(arguments.png + ": cannot be written");
-    return 0;
+    return reportTouches(arguments, arguments.recording, arguments.recording + "/rig.yml", recording.rig(),
+                         eval::truthFrames(recording), detected);
 }
 
 }  // namespace
