@@ -5,11 +5,57 @@
 #include <stdexcept>
 
 #include <opencv2/core.hpp>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace everytouch::core {
 
 namespace {
+
+#if CV_SIMD
+// The difference of two vectors of 8-bit values as 16-bit values (the lower and the upper half of the lanes),
+// and their mean rounded up.
+inline void differenceAndMean(const cv::v_uint8& plus, const cv::v_uint8& minus, cv::v_int16& low,
+                              cv::v_int16& high, cv::v_uint8& mean) {
+    cv::v_uint16 plusLow, plusHigh, minusLow, minusHigh;
+    cv::v_expand(plus, plusLow, plusHigh);
+    cv::v_expand(minus, minusLow, minusHigh);
+    low = cv::v_reinterpret_as_s16(plusLow) - cv::v_reinterpret_as_s16(minusLow);
+    high = cv::v_reinterpret_as_s16(plusHigh) - cv::v_reinterpret_as_s16(minusHigh);
+    mean = cv::v_rshr_pack<1>(plusLow + minusLow, plusHigh + minusHigh);
+}
+
+// Pixels [0, return value) of one row, a vector at a time: interleaved channels keep the compiler from
+// vectorising the plain loop, which took a quarter of the pipeline's time.
+template <int Channels>
+int subtractAndAverageVectors(const uchar* plus, const uchar* minus, short* s, uchar* t, int width) {
+    constexpr int kLanes = cv::v_uint8::nlanes;
+    int x = 0;
+    for (; x + kLanes <= width; x += kLanes) {
+        cv::v_int16 low, high;
+        if constexpr (Channels == 1) {
+            cv::v_uint8 mean;
+            differenceAndMean(cv::vx_load(plus + x), cv::vx_load(minus + x), low, high, mean);
+            cv::v_store(t + x, mean);
+        } else {
+            cv::v_uint8 a0, a1, a2, b0, b1, b2;
+            cv::v_load_deinterleave(plus + 3 * x, a0, a1, a2);
+            cv::v_load_deinterleave(minus + 3 * x, b0, b1, b2);
+            cv::v_int16 low1, high1, low2, high2;
+            cv::v_uint8 mean0, mean1, mean2;
+            differenceAndMean(a0, b0, low, high, mean0);
+            differenceAndMean(a1, b1, low1, high1, mean1);
+            differenceAndMean(a2, b2, low2, high2, mean2);
+            low = cv::v_max(low, cv::v_max(low1, low2));
+            high = cv::v_max(high, cv::v_max(high1, high2));
+            cv::v_store_interleave(t + 3 * x, mean0, mean1, mean2);
+        }
+        cv::v_store(s + x, low);
+        cv::v_store(s + x + kLanes / 2, high);
+    }
+    return x;
+}
+#endif
 
 template <int Channels>
 void subtractAndAverage(const cv::Mat& positive, const cv::Mat& negative, cv::Mat& subtraction,
@@ -19,13 +65,21 @@ void subtractAndAverage(const cv::Mat& positive, const cv::Mat& negative, cv::Ma
         const uchar* minus = negative.ptr<uchar>(y);
         short* s = subtraction.ptr<short>(y);
         uchar* t = texture.ptr<uchar>(y);
-        for (int x = 0; x < positive.cols; ++x) {
+        int x = 0;
+#if CV_SIMD
+        x = subtractAndAverageVectors<Channels>(plus, minus, s, t, positive.cols);
+        plus += Channels * x;
+        minus += Channels * x;
+        s += x;
+        t += Channels * x;
+#endif
+        for (; x < positive.cols; ++x) {
             int largest = plus[0] - minus[0];
             for (int c = 0; c < Channels; ++c) {
                 largest = std::max(largest, plus[c] - minus[c]);
                 t[c] = static_cast<uchar>((plus[c] + minus[c] + 1) >> 1);
             }
-            s[x] = static_cast<short>(largest);
+            *s++ = static_cast<short>(largest);
             plus += Channels;
             minus += Channels;
             t += Channels;

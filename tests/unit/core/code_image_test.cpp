@@ -13,11 +13,14 @@ namespace {
 using ::testing::HasSubstr;
 using ::testing::Optional;
 
+// 67 pixels wide: whole vectors of every width and a remainder.
+constexpr int kWidth = 67;
+
 FramePair randomPair(int type, int seed) {
     cv::RNG rng(seed);
     FramePair pair;
-    pair.positive.image.create(48, 64, type);
-    pair.negative.image.create(48, 64, type);
+    pair.positive.image.create(48, kWidth, type);
+    pair.negative.image.create(48, kWidth, type);
     rng.fill(pair.positive.image, cv::RNG::UNIFORM, 0, 256);
     rng.fill(pair.negative.image, cv::RNG::UNIFORM, 0, 256);
     pair.negative.polarity = Polarity::Negative;
@@ -31,7 +34,7 @@ TEST(SubtractionAndTexture, GrayFramesGiveTheirDifferenceAndRoundedMean) {
     ASSERT_EQ(subtraction.type(), CV_16SC1);
     ASSERT_EQ(texture.type(), CV_8UC1);
     for (int y = 0; y < 48; ++y)
-        for (int x = 0; x < 64; ++x) {
+        for (int x = 0; x < kWidth; ++x) {
             const int plus = pair.positive.image.at<uchar>(y, x);
             const int minus = pair.negative.image.at<uchar>(y, x);
             ASSERT_EQ(subtraction.at<short>(y, x), plus - minus);
@@ -45,7 +48,7 @@ TEST(SubtractionAndTexture, ColourFramesGiveTheLargestChannelDifferenceAndThePer
     computeSubtractionAndTexture(pair, subtraction, texture);
     ASSERT_EQ(texture.type(), CV_8UC3);
     for (int y = 0; y < 48; ++y)
-        for (int x = 0; x < 64; ++x) {
+        for (int x = 0; x < kWidth; ++x) {
             const cv::Vec3b plus = pair.positive.image.at<cv::Vec3b>(y, x);
             const cv::Vec3b minus = pair.negative.image.at<cv::Vec3b>(y, x);
             int largest = -256;
