@@ -193,6 +193,11 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
                              track.unmeasuredFrames == 0 && track.heightMm > touchHeightMm;
         if (!stillDown)
             ++track.unmeasuredFrames;
+        // A touch-down pending through more frames without a height than a touch survives is forgotten: a
+        // low height read that long ago says nothing of where the finger is now (a hand's outline passing
+        // high shows a fingertip now and then, and its track may next be matched far away).
+        if (!track.touching && track.unmeasuredFrames > options_.maxUnmeasuredFrames)
+            track.pending = false;
         if (track.touching && (leaving || track.unmeasuredFrames > options_.maxUnmeasuredFrames)) {
             track.touching = false;
             track.pending = false;

@@ -279,6 +279,33 @@ TEST(ContactTracker, AHeightAboveTheTouchHeightThenNoCodeNearTheTableLiftsAtOnce
     EXPECT_FALSE(feed.contacts()[0].touching);
 }
 
+TEST(ContactTracker, APendingTouchDownOutlivesNoMoreFramesWithoutAHeightThanATouchDoes) {
+    const int frames = TrackerOptions{}.maxUnmeasuredFrames;
+    // One frame just below the touch height does not decide; a second low frame within as many frames
+    // without a height as a touch outlives confirms it.
+    Feed near;
+    near({finger({60, 40}, 20)});
+    near({finger({60, 40}, kTouchMm - 0.5)});
+    ASSERT_FALSE(near.contacts()[0].touching);
+    for (int f = 0; f < frames; ++f)
+        near({unmeasured({60, 40})});
+    near({finger({61, 40}, kTouchMm - 0.5)});
+    EXPECT_TRUE(near.contacts()[0].touching);
+
+    // One frame more without a height and the low frame is forgotten: the track, matched 40 mm away (a
+    // fingertip of a hand's outline passing high), needs two low frames of its own.
+    Feed far;
+    far({finger({60, 40}, 20)});
+    far({finger({60, 40}, kTouchMm - 0.5)});
+    for (int f = 0; f <= frames; ++f)
+        far({unmeasured({60, 40})});
+    far({finger({100, 40}, kTouchMm - 0.5)});
+    ASSERT_EQ(far.contacts().size(), 1u);
+    EXPECT_FALSE(far.contacts()[0].touching);
+    far({finger({100, 40}, kTouchMm - 0.5)});
+    EXPECT_TRUE(far.contacts()[0].touching);
+}
+
 TEST(ContactTracker, AFingertipWithoutAHeightStartsNoContact) {
     Feed feed;
     EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
