@@ -3,7 +3,6 @@
 #include <string>
 #include <unordered_map>
 
-#include "core/frame_pairer.h"
 #include "io/input_error.h"
 
 namespace everytouch::eval {
@@ -33,19 +32,23 @@ DetectedFrames contactsFromLog(const io::Recording& recording, const std::vector
     return frames;
 }
 
+PipelineContacts::PipelineContacts(const io::RigDescription& rig, const core::DetectionOptions& options,
+                                   double touchHeightMm)
+    : pipeline_(options), settings_{rig.calibration, rig.pattern, touchHeightMm} {}
+
+void PipelineContacts::add(const core::Frame& frame, DetectedFrames& frames) {
+    frames.push_back(frames.empty() ? core::Contacts{} : frames.back());
+    if (const std::optional<core::FramePair> pair = pairer_.push(frame))
+        frames.back() = pipeline_.process(*pair, settings_).contacts;
+}
+
 DetectedFrames contactsFromPipeline(const io::Recording& recording, const core::DetectionOptions& options,
                                     double touchHeightMm) {
-    core::TouchPipeline pipeline(options);
-    const core::PipelineSettings settings{recording.rig().calibration, recording.rig().pattern,
-                                          touchHeightMm};
-    core::FramePairer pairer;
-    DetectedFrames frames(recording.frames().size());
-    for (std::size_t position = 0; position < frames.size(); ++position) {
-        if (position > 0)
-            frames[position] = frames[position - 1];
-        if (const std::optional<core::FramePair> pair = pairer.push(recording.loadFrame(position)))
-            frames[position] = pipeline.process(*pair, settings).contacts;
-    }
+    PipelineContacts pipeline(recording.rig(), options, touchHeightMm);
+    DetectedFrames frames;
+    frames.reserve(recording.frames().size());
+    for (std::size_t position = 0; position < recording.frames().size(); ++position)
+        pipeline.add(recording.loadFrame(position), frames);
     return frames;
 }
 

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/contact.h"
+#include "core/frame_pairer.h"
 #include "core/touch_pipeline.h"
 #include "io/recording.h"
 #include "io/touch_log.h"
@@ -19,8 +20,23 @@ using DetectedFrames = std::vector<core::Contacts>;
 DetectedFrames contactsFromLog(const io::Recording& recording, const std::vector<io::TouchLogEntry>& log,
                                const std::filesystem::path& logPath);
 
-// Runs core::TouchPipeline over `recording`'s frames as the daemon does (each frame paired with the previous
-// one of opposite polarity, the contacts reported at the newer frame), with the rig's calibration and code.
+// Runs core::TouchPipeline frame by frame as the daemon does (each frame paired with the previous one of
+// opposite polarity, the contacts reported at the newer frame), with a rig's calibration and code.
+class PipelineContacts {
+public:
+    PipelineContacts(const io::RigDescription& rig, const core::DetectionOptions& options,
+                     double touchHeightMm);
+    // Appends the contacts in effect after `frame` to `frames`: the pipeline's when the frame completes a
+    // pair, the previous frame's otherwise.
+    void add(const core::Frame& frame, DetectedFrames& frames);
+
+private:
+    core::TouchPipeline pipeline_;
+    core::PipelineSettings settings_;
+    core::FramePairer pairer_;
+};
+
+// PipelineContacts over `recording`'s frames.
 DetectedFrames contactsFromPipeline(const io::Recording& recording, const core::DetectionOptions& options,
                                     double touchHeightMm);
 

@@ -178,10 +178,12 @@ struct TouchArguments {
 };
 
 CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
-    CLI::App* command = app.add_subcommand(
-        "touches",
-        "Score detected touches against truth.csv: FRR and FAR per tap trial, touch point error epsilon, "
-        "touch-down latency, drag deviation, id swaps, hover height error");
+    CLI::App* command =
+        app.add_subcommand("touches",
+                           "Score detected touches against the ground truth (truth.csv, or the simulated "
+                           "rig's own with --rig): FRR "
+                           "and FAR per tap trial, touch point error epsilon, "
+                           "touch-down latency, drag deviation, id swaps, hover height error");
     CLI::Option* recording =
         command->add_option("REC", arguments.recording, "Recording directory with truth.csv");
     command

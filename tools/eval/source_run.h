@@ -3,7 +3,6 @@
 #include <cstddef>
 #include <string>
 
-#include "core/touch_pipeline.h"
 #include "eval/detected_contacts.h"
 #include "eval/touch_trials.h"
 #include "io/frame_source.h"
