@@ -20,9 +20,13 @@ namespace everytouch::core {
 struct HeightOptions {
     double maxHeightMm = 48.0;  // candidate heights from 0 up to this (mm)
     double stepMm = 1.0;        // between candidate heights (mm): a fifth of a projector pixel of parallax
-    // Light spreads inside skin before it leaves it (Gaussian sigma, mm): about a millimetre for red light,
-    // which blurs the code on a finger beyond what the camera resolves.
-    double skinScatterMm = 0.8;
+    // How skin blurs the code it returns (Gaussian sigma, mm), summed over the camera's channels: part of the
+    // light leaves at the surface where it fell, the rest after spreading inside, about a millimetre for red
+    // light and a third of that for blue. One Gaussian with the second moment of that mix is about 0.5 mm.
+    // Red light's spread alone (0.8 mm) blurred the prediction more than the code on skin is blurred: the
+    // peak then follows the code's coarse structure, whose chance alignments moved it by 1-2 mm from one
+    // fingertip position to the next (docs/detection.md).
+    double skinScatterMm = 0.5;
     // The fingertip region: hand pixels within regionWidths finger widths of a point centreBehindWidths
     // behind the silhouette's end: the last joint's end, whose height follows the pad's more closely than
     // the finger's back further up, which tilts with the finger.

@@ -2,7 +2,9 @@
 // that slides on the table in rendered frame pairs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "core/camera_model.h"
 #include "core/code_image.h"
@@ -16,9 +18,23 @@ namespace everytouch::core {
 namespace {
 
 struct SlideScore {
-    int frames = 0;  // pairs in which a touching fingertip moved and was found
-    int read = 0;    // of them, those whose height came out within toleranceMm of the truth's
+    int frames = 0;                // pairs in which a touching fingertip moved and was found
+    int read = 0;                  // of them, those whose height came out within toleranceMm of the truth's
+    std::vector<double> errorsMm;  // every height given, less the truth's
     double rate() const { return frames ? static_cast<double>(read) / frames : 0.0; }
+    // The errors' spread as one standard deviation, from their median absolute deviation: a chance peak
+    // elsewhere in the range is a frame without a height to the tracker, not scatter about the surface.
+    double spreadMm() const {
+        std::vector<double> values = errorsMm;
+        const auto median = [&] {
+            std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+            return values[values.size() / 2];
+        };
+        const double centre = median();
+        for (double& value : values)
+            value = std::abs(value - centre);
+        return 1.4826 * median();
+    }
 };
 
 const sim::FingertipTruth* presentedFinger(const sim::FrameTruth& truth) {
@@ -80,6 +96,8 @@ SlideScore scoreSlidingFingertips(const HeightOptions& heightOptions, double tol
         const float trueHeight = truth.visibleHeightMm.at<float>(static_cast<int>(std::lround(centre.y())),
                                                                  static_cast<int>(std::lround(centre.x())));
         score.read += estimate.valid && std::abs(estimate.heightMm - trueHeight) <= toleranceMm;
+        if (estimate.valid)
+            score.errorsMm.push_back(estimate.heightMm - trueHeight);
     }
     return score;
 }
@@ -119,14 +137,18 @@ TEST(SurfaceHeightRendered, TheCodeThroughAPlaneGivesThatPlanesHeight) {
     }
 }
 
-TEST(SurfaceHeightRendered, ASlidingFingertipsHeightIsRead) {
+TEST(SurfaceHeightRendered, ASlidingFingertipsHeightIsReadAndKeepsToItsSurface) {
     // A finger sliding at 60 mm/s moves half a millimetre between the two frames of a pair: its shading's
     // trace in the difference outweighs the faint code on skin unless the texture's gradient explains it.
     const SlideScore score = scoreSlidingFingertips(HeightOptions{}, 4.0);
     ASSERT_GE(score.frames, 30) << "the test needs sliding fingertips in view";
-    // 0.53 of them read within 4 mm as measured; 0.15 with explainMotion off (the same test, that option
-    // false).
+    // 0.59 of them read within 4 mm as measured (0.53 with skinScatterMm 0.8); 0.15 with explainMotion off
+    // (the same test, that option false, measured with skinScatterMm 0.8).
     EXPECT_GE(score.rate(), 0.45) << score.read << " of " << score.frames << " frames";
+    // Each frame of a slide puts other bits of the code under the fingertip. A prediction blurred as skin
+    // blurs the code keeps the peak on the surface: 1.59 mm as measured; 2.34 mm with skin's blur taken as
+    // red light's alone (skinScatterMm 0.8), whose peak follows the code's coarse structure instead.
+    EXPECT_LE(score.spreadMm(), 2.0) << "over " << score.errorsMm.size() << " heights";
 }
 
 }  // namespace
