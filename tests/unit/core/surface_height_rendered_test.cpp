@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "core/camera_model.h"
@@ -25,6 +26,8 @@ struct SlideScore {
     // The errors' spread as one standard deviation, from their median absolute deviation: a chance peak
     // elsewhere in the range is a frame without a height to the tracker, not scatter about the surface.
     double spreadMm() const {
+        if (errorsMm.empty())
+            return std::numeric_limits<double>::infinity();
         std::vector<double> values = errorsMm;
         const auto median = [&] {
             std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
