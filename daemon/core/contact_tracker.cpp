@@ -250,7 +250,6 @@ void ContactTracker::updateTouch(Track& track, const FingerObservation& finger, 
         return;
     }
     double liftMm = touchHeightMm + std::max(options_.minHysteresisMm, options_.hysteresisSigmas * sigma);
-    double decisiveUpMm = decisiveMm;
     // Once learned, only readings within the band of the resting level are of the finger at rest: a finger
     // rising slowly must not carry its level up with it.
     bool resting = finger.padHeightMm <= liftMm;
@@ -258,14 +257,14 @@ void ContactTracker::updateTouch(Track& track, const FingerObservation& finger, 
         const double bandMm =
             std::max(options_.minHysteresisMm, options_.hysteresisSigmas * track.resting.spreadMm());
         liftMm = std::max(touchHeightMm, track.resting.meanMm) + bandMm;
-        decisiveUpMm = std::max(options_.minHysteresisMm, options_.decisiveSigmas * track.resting.spreadMm());
         resting = finger.padHeightMm <= track.resting.meanMm + bandMm;
     }
     if (resting)
         track.resting.add(finger.padHeightMm);
-    const double aboveMm = finger.padHeightMm - liftMm;
-    const bool up = aboveMm > 0.0;
-    if (up && (track.pending || aboveMm >= decisiveUpMm)) {
+    // A lift always takes two frames running: a chance correlation peak reads a resting fingertip 8-11 mm
+    // up for a single frame, decisively above any band, on printed content several times a tap.
+    const bool up = finger.padHeightMm > liftMm;
+    if (up && track.pending) {
         track.touching = false;
         track.pending = false;
     } else {

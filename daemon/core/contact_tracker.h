@@ -54,9 +54,11 @@ struct TrackerOptions {
     // The band is at least this many standard deviations of the height estimate: a finger resting exactly at
     // the touch height then shows a lift (two frames running above the band) once in 5 * 10^5 frames.
     double hysteresisSigmas = 3.0;
-    // One frame suffices for a touch-down or a lift when the height is past its threshold by this many
-    // standard deviations and by at least minHysteresisMm; otherwise two frames running are needed. A finger
-    // hovering just above the touch height dips 4 sigma below it once in 3 * 10^4 frames.
+    // One frame suffices for a touch-down when the height is below the touch height by this many standard
+    // deviations and by at least minHysteresisMm; otherwise two frames running are needed. A finger hovering
+    // just above the touch height dips 4 sigma below it once in 3 * 10^4 frames. A lift always needs two:
+    // a correlation peak of chance reads a resting fingertip 8-11 mm up for a single frame, beyond any
+    // Gaussian tail, several times a tap over printed content.
     double decisiveSigmas = 4.0;
     // Pad heights read while a finger rests, after which the lift is judged against that finger's own
     // resting level and scatter instead of the observation's uncertainty. The pad height subtracts a prior
@@ -107,10 +109,11 @@ struct TrackerOptions {
 //   above the touch height, lifts a touching finger at once: it was seen leaving the table, and nothing
 //   puts it back (the two frames running of the debouncing). An observation without a height moves only a
 //   touching track (its point lies on the table) and starts no track; an implausible one moves none.
-// - Debouncing: a change needs its condition in two observed frames running, or in one frame when the height
-//   is past the threshold by max(minHysteresisMm, decisiveSigmas * sigma). So a touch-down or lift is
-//   reported in the first frame that meets its condition when the evidence is decisive, and otherwise in the
-//   second frame running that meets it: at most one frame (8.3 ms at 120 Hz) late. A single frame that
+// - Debouncing: a change needs its condition in two observed frames running; a touch-down also in one frame
+//   when the height is below the touch height by max(minHysteresisMm, decisiveSigmas * sigma). So a
+//   touch-down is reported in the first frame that meets its condition when the evidence is decisive, and
+//   otherwise, like a lift, in the second frame running that meets it: at most one frame (8.3 ms at 120 Hz)
+//   late. A single frame that
 //   meets the condition without deciding changes nothing. A frame without an observation neither confirms
 //   nor cancels, so a missed frame in between adds its own frame; so do frames without a height, but after
 //   more than maxUnmeasuredFrames of them running a pending touch-down is forgotten.
