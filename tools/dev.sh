@@ -63,7 +63,9 @@ sanitize)
     # -O1 -g1 keeps file:line in every report and halves the compile time of -O2 -g under ASan. The test
     # cases at -O0 compiled in half the time but ran the simulator's tests 3-9 times slower (Eigen inlined
     # into them): the whole run took 3.5 minutes longer.
-    build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF -DEVERYTOUCH_WERROR=OFF \
+    # The benchmarks and the developers' tools run no test: the normal build compiles them.
+    build build-sanitize -DEVERYTOUCH_SANITIZE=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF \
+        -DEVERYTOUCH_BUILD_DEVELOPER_TOOLS=OFF -DEVERYTOUCH_WERROR=OFF \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
     # The projector step end to end on the simulated rig renders some 500 frames of a moving board, minutes
     # under ASan, and a new user's "calibrate full" some 2200 (38 s in the normal build, 278 s under ASan on a
