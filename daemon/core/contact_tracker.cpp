@@ -261,8 +261,9 @@ void ContactTracker::updateTouch(Track& track, const FingerObservation& finger, 
     }
     if (resting)
         track.resting.add(finger.padHeightMm);
-    // A lift always takes two frames running: a chance correlation peak reads a resting fingertip 8-11 mm
-    // up for a single frame, decisively above any band, on printed content several times a tap.
+    // A lift always takes two frames running: a resting fingertip whose end the segmentation loses for a
+    // frame (over pale content, several times a tap) is read on the finger further back, 8-11 mm up, far
+    // beyond any band.
     const bool up = finger.padHeightMm > liftMm;
     if (up && track.pending) {
         track.touching = false;

@@ -57,8 +57,8 @@ struct TrackerOptions {
     // One frame suffices for a touch-down when the height is below the touch height by this many standard
     // deviations and by at least minHysteresisMm; otherwise two frames running are needed. A finger hovering
     // just above the touch height dips 4 sigma below it once in 3 * 10^4 frames. A lift always needs two:
-    // a correlation peak of chance reads a resting fingertip 8-11 mm up for a single frame, beyond any
-    // Gaussian tail, several times a tap over printed content.
+    // a resting fingertip whose end the segmentation loses for a frame reads 8-11 mm up, beyond any
+    // Gaussian tail, several times a tap over pale printed content.
     double decisiveSigmas = 4.0;
     // Pad heights read while a finger rests, after which the lift is judged against that finger's own
     // resting level and scatter instead of the observation's uncertainty. The pad height subtracts a prior

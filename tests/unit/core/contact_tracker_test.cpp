@@ -521,8 +521,8 @@ TEST(ContactTracker, ALiftNeedsTwoFramesRunning) {
     touchChanges(twoFrames, {0, 5.0, 5.0, 5.0}, kSigmaMm, &states);  // above 4.5 mm
     EXPECT_THAT(states, ::testing::ElementsAre(true, true, false, false));
     states.clear();
-    // However far above the band, one frame alone is a chance reading: a resting fingertip read 10 mm up
-    // for a frame stays down.
+    // However far above the band, one frame alone is no lift: a resting fingertip read 10 mm up for a
+    // frame stays down.
     Feed far;
     touchChanges(far, {0, 0, 10.0, 0, 0, 10.0, 10.0}, kSigmaMm, &states);
     EXPECT_THAT(states, ::testing::ElementsAre(true, true, true, true, true, true, false));
