@@ -113,10 +113,10 @@ struct TrackerOptions {
 //   when the height is below the touch height by max(minHysteresisMm, decisiveSigmas * sigma). So a
 //   touch-down is reported in the first frame that meets its condition when the evidence is decisive, and
 //   otherwise, like a lift, in the second frame running that meets it: at most one frame (8.3 ms at 120 Hz)
-//   late. A single frame that
-//   meets the condition without deciding changes nothing. A frame without an observation neither confirms
-//   nor cancels, so a missed frame in between adds its own frame; so do frames without a height, but after
-//   more than maxUnmeasuredFrames of them running a pending touch-down is forgotten.
+//   late. A single frame that meets the condition without deciding changes nothing. A frame without an
+//   observation neither confirms nor cancels, so a missed frame in between adds its own frame; so do frames
+//   without a height, but after more than maxUnmeasuredFrames of them running a pending touch-down is
+//   forgotten.
 // - Position: the One Euro filter per track on display pixels, started afresh at touch-down so that a touch
 //   begins at its measured point. A track without an observation stays where it was.
 // - Palms: a track that has been matched to a palm observation is a palm for the rest of its life and never
