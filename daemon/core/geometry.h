@@ -7,6 +7,9 @@
 
 namespace everytouch::core {
 
+// Standard deviation of a box one unit wide (a uniform distribution's): how a pixel's footprint blurs.
+inline constexpr double kBoxSigmaPerWidth = 0.28867513459481287;  // 1 / sqrt(12)
+
 // Homography from the plane z = heightMm of the table frame to a pinhole device's pixels (undistorted):
 // K [r1, r2, heightMm * r3 + t] (paper eq. 19-21). `tableToDevice` maps table millimetres into the device
 // frame.

@@ -13,8 +13,6 @@ namespace everytouch::core {
 
 namespace {
 
-constexpr double kBoxSigmaPerWidth = 0.28867513459481287;  // 1 / sqrt(12): a box one unit wide
-
 // Bilinear sample of a CV_32FC1 image; 0 outside.
 float sample(const cv::Mat& image, float x, float y) {
     const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));

@@ -11,9 +11,6 @@ namespace everytouch::core {
 
 namespace {
 
-// Standard deviation of a box one unit wide: the variance of a uniform distribution.
-constexpr double kBoxSigmaPerWidth = 0.28867513459481287;  // 1 / sqrt(12)
-
 double footprintAtCentre(const Calibration& calibration) {
     const Eigen::Matrix3d toProjector = calibration.cameraToProjectorHomography(0.0);
     const Eigen::Vector2d centre(calibration.cameraSize.width / 2.0, calibration.cameraSize.height / 2.0);

@@ -12,4 +12,8 @@ std::string fileContents(const std::filesystem::path& path) {
     return text.str();
 }
 
+void writeText(const std::filesystem::path& path, const std::string& text) {
+    std::ofstream(path) << text;
+}
+
 }  // namespace everytouch::test

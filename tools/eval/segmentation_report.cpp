@@ -3,13 +3,11 @@
 #include <cstdio>
 #include <optional>
 
+#include "eval/optional_json.h"
+
 namespace everytouch::eval {
 
 namespace {
-
-nlohmann::json orNull(const std::optional<double>& value) {
-    return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-}
 
 nlohmann::json scoreJson(const SegmentationScore& score) {
     const PixelCounts& total = score.total();

@@ -2,13 +2,11 @@
 
 #include <cstdio>
 
+#include "eval/optional_json.h"
+
 namespace everytouch::eval {
 
 namespace {
-
-nlohmann::json orNull(const std::optional<double>& value) {
-    return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
-}
 
 nlohmann::json meanJson(const Mean& mean) {
     return {{"mean", orNull(mean.value())}, {"count", mean.count}};

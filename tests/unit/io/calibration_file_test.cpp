@@ -1,6 +1,5 @@
 #include "io/calibration_file.h"
 
-#include <fstream>
 #include <regex>
 
 #include <gmock/gmock.h>
@@ -17,10 +16,6 @@ namespace {
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream(path) << text;
-}
-
 class CalibrationFileTest : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -33,7 +28,7 @@ protected:
         const std::string bad = std::regex_replace(goodText_, std::regex(pattern), replacement,
                                                    std::regex_constants::format_first_only);
         EXPECT_NE(bad, goodText_) << "pattern " << pattern << " did not match";
-        writeText(badPath_, bad);
+        test::writeText(badPath_, bad);
         try {
             readCalibrationFile(badPath_);
         } catch (const InputError& error) {
@@ -106,12 +101,12 @@ TEST_F(CalibrationFileTest, RejectsTransformThatIsNotRigid) {
 }
 
 TEST_F(CalibrationFileTest, RejectsTruncatedFile) {
-    writeText(badPath_, goodText_.substr(0, goodText_.size() / 2));
+    test::writeText(badPath_, goodText_.substr(0, goodText_.size() / 2));
     EXPECT_THROW(readCalibrationFile(badPath_), InputError);
 }
 
 TEST_F(CalibrationFileTest, RejectsGarbageAndMissingFile) {
-    writeText(badPath_, "{{{ this is : not [ yaml");
+    test::writeText(badPath_, "{{{ this is : not [ yaml");
     EXPECT_THROW(readCalibrationFile(badPath_), InputError);
     EXPECT_THAT([&] { readCalibrationFile(dir_ / "nowhere.yml"); },
                 ::testing::ThrowsMessage<InputError>(HasSubstr("nowhere.yml")));

@@ -21,11 +21,11 @@ constexpr double kPxPerMm = 1280.0 / 276.5;
 constexpr std::int64_t kFrameUs = 8333;
 constexpr double kTouchMm = 3.0;
 
-core::FingerObservation finger(double xMm, double yMm, double heightMm) {
+core::FingerObservation observedFinger(double xMm, double yMm, double heightMm) {
     return {Eigen::Vector2d(xMm, yMm) * kPxPerMm, heightMm, 0.5, false};
 }
 
-core::FingerObservation palm(double xMm, double yMm, double heightMm = 0.0) {
+core::FingerObservation observedPalm(double xMm, double yMm, double heightMm = 0.0) {
     return {Eigen::Vector2d(xMm, yMm) * kPxPerMm, heightMm, 0.5, true};
 }
 
@@ -109,7 +109,7 @@ TEST(ContactTrackerOnTheTouchscreen, APalmNeverTouches) {
         const double x = 150.0 + jitter(random) + (f > 200 ? 3.0 * (f - 200) : 0.0);
         const double y = 180.0 + jitter(random);
         const bool misread = f % 50 == 25 || f % 50 == 26;
-        screen.frame({misread ? finger(x, y, 0.0) : palm(x, y)});
+        screen.frame({misread ? observedFinger(x, y, 0.0) : observedPalm(x, y)});
     }
     screen.frame({});
     EXPECT_EQ(screen.reader.downs, 0);
@@ -120,17 +120,17 @@ TEST(ContactTrackerOnTheTouchscreen, ATouchTurningIntoAPalmIsCancelledNotLifted)
     TrackerToTouchscreen screen;
     // A finger comes down beside a resting palm, and a second finger touches elsewhere.
     for (int f = 0; f < 20; ++f)
-        screen.frame({palm(60, 200), finger(150, 120, 6.0 - 0.5 * f), finger(220, 90, 0.0)});
+        screen.frame({observedPalm(60, 200), observedFinger(150, 120, 6.0 - 0.5 * f), observedFinger(220, 90, 0.0)});
     EXPECT_EQ(screen.reader.downs, 2);
     EXPECT_EQ(screen.reader.buttonTouch, 1);
     // The hand flattens: the first finger is now seen as part of a palm, then the hand lifts away.
     for (int f = 0; f < 20; ++f)
-        screen.frame({palm(60, 200), palm(151, 121), finger(220, 90, 0.0)});
+        screen.frame({observedPalm(60, 200), observedPalm(151, 121), observedFinger(220, 90, 0.0)});
     EXPECT_EQ(screen.reader.cancels, 1);
     EXPECT_EQ(screen.reader.ups, 0);
     EXPECT_EQ(screen.reader.buttonTouch, 1);  // the other finger still counts
     for (int f = 0; f < 5; ++f)
-        screen.frame({finger(220, 90, 0.0)});
+        screen.frame({observedFinger(220, 90, 0.0)});
     for (int f = 0; f < 5; ++f)
         screen.frame({});
     // Only the finger that stayed a finger was lifted; nothing else ever touched.

@@ -1,6 +1,5 @@
 #include "io/recording.h"
 
-#include <fstream>
 #include <regex>
 
 #include <gmock/gmock.h>
@@ -18,10 +17,6 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
-
-void writeText(const std::filesystem::path& path, const std::string& text) {
-    std::ofstream(path) << text;
-}
 
 core::Frame makeFrame(std::uint64_t index, const cv::Size& size) {
     core::Frame frame;
@@ -72,7 +67,7 @@ protected:
         const std::string after = std::regex_replace(before, std::regex(pattern), replacement,
                                                      std::regex_constants::format_first_only);
         ASSERT_NE(before, after) << pattern;
-        writeText(dir_ / file, after);
+        test::writeText(dir_ / file, after);
     }
 
     test::TempDir dir_;
@@ -154,7 +149,7 @@ TEST_F(RecordingTest, RejectsMissingMaskFile) {
 
 TEST_F(RecordingTest, RejectsMasksThatAreNotADirectory) {
     std::filesystem::remove_all(dir_ / "masks");
-    writeText(dir_ / "masks", "not a directory\n");
+    test::writeText(dir_ / "masks", "not a directory\n");
     EXPECT_THAT(complaint(), AllOf(HasSubstr("masks"), HasSubstr("directory")));
 }
 
@@ -188,7 +183,7 @@ TEST_F(RecordingTest, MaskWithValuesOtherThan0And255IsRejectedWhenRead) {
 }
 
 TEST_F(RecordingTest, UnreadableMaskIsRejectedWhenRead) {
-    writeText(Recording::maskPath(dir_.path(), 0), "not a png");
+    test::writeText(Recording::maskPath(dir_.path(), 0), "not a png");
     EXPECT_THAT(maskComplaint(dir_.path(), 0),
                 AllOf(HasSubstr("masks/000000.png"), HasSubstr("not a readable")));
 }
@@ -216,7 +211,7 @@ TEST_F(RecordingTest, RejectsMissingFrameFile) {
 
 TEST_F(RecordingTest, RejectsTruncatedFramesLine) {
     const std::string text = test::fileContents(dir_ / "frames.csv");
-    writeText(dir_ / "frames.csv", text.substr(0, text.size() - 4));
+    test::writeText(dir_ / "frames.csv", text.substr(0, text.size() - 4));
     EXPECT_THAT(complaint(), AllOf(HasSubstr("frames.csv"), HasSubstr("line 5")));
 }
 

@@ -10,17 +10,10 @@
 #include "core/table_rectangle.h"
 #include "sim/rig_geometry.h"
 #include "sim/simulator.h"
+#include "support/random_pattern.h"
 
 namespace everytouch::sim {
 namespace {
-
-// Any code will do here; the rig's own takes a second to generate.
-cv::Mat randomPattern(cv::Size size) {
-    cv::Mat pattern(size, CV_8UC1);
-    cv::RNG rng(3);
-    rng.fill(pattern, cv::RNG::UNIFORM, 0, 2);
-    return pattern;
-}
 
 Eigen::Vector2d project(const core::Calibration& calibration, const Eigen::Vector3d& point) {
     const Eigen::Vector3d q = calibration.cameraMatrix * (calibration.tableToCamera * point);
@@ -81,7 +74,7 @@ TEST(ProjectImage, SquareLandsWhereTheTableHomographyPutsIt) {
     SimParameters p;
     p.scenario = "idle";
     p.content = "gray";
-    Simulator simulator(p, randomPattern(p.projectorSize));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
     const core::Calibration& calibration = simulator.calibration();
     const cv::Rect square(300, 180, 80, 60);
     for (const bool whiteOnBlack : {true, false}) {
@@ -157,8 +150,8 @@ TEST(ProjectImage, EmptyImageReturnsToTheContentAndWrongImagesAreRejected) {
     SimParameters p;
     p.scenario = "idle";
     p.content = "gray";
-    Simulator plain(p, randomPattern(p.projectorSize));
-    Simulator projecting(p, randomPattern(p.projectorSize));
+    Simulator plain(p, test::randomPattern(p.projectorSize, 3));
+    Simulator projecting(p, test::randomPattern(p.projectorSize, 3));
     core::Frame a, b;
     FrameTruth truth;
     projecting.projectImage(cv::Mat(p.projectorSize, CV_8UC3, cv::Scalar(0, 0, 255)));
@@ -180,7 +173,7 @@ TEST(TableSetupScenario, TheStripeIsFoundWhereTheCardLies) {
         SimParameters p;
         p.scenario = "table-setup";
         p.seed = seed;
-        Simulator simulator(p, randomPattern(p.projectorSize));
+        Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
         simulator.projectImage(chessboardImage(p.projectorSize));
         const FramePair pair = renderPair(simulator, 240);
         ASSERT_TRUE(pair.truth.props.card);
@@ -206,7 +199,7 @@ TEST(TableSetupScenario, TheStripeIsFoundWhereTheCardLies) {
 TEST(PairCalibrationScenario, PosesAreWhatTheCalibrationNeeds) {
     SimParameters p;
     p.scenario = "pair-calibration";
-    const core::Calibration calibration = Simulator(p, randomPattern(p.projectorSize)).calibration();
+    const core::Calibration calibration = Simulator(p, test::randomPattern(p.projectorSize, 3)).calibration();
     for (const std::uint64_t seed : {1u, 2u, 3u}) {
         const PairCalibrationScenario scenario({calibration, seed, 1.0});
         const CalibrationStage stage(calibration, calibrationChessboard());
@@ -255,7 +248,7 @@ TEST(PairCalibrationScenario, ARigWithoutRoomForTheCardIsRefusedWithTheReason) {
     p.projectorFocalPx =
         1100.0;  // a longer throw: the border around the chessboard gets narrower than the card
     try {
-        Simulator simulator(p, randomPattern(p.projectorSize));
+        Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
         FAIL() << "expected std::invalid_argument";
     } catch (const std::invalid_argument& error) {
         EXPECT_NE(std::string(error.what()).find("the card does not fit"), std::string::npos) << error.what();
@@ -265,7 +258,7 @@ TEST(PairCalibrationScenario, ARigWithoutRoomForTheCardIsRefusedWithTheReason) {
 TEST(PairCalibrationScenario, HoldsSevenStillScenesAndMovesBetweenThem) {
     SimParameters p;
     p.scenario = "pair-calibration";
-    Simulator simulator(p, randomPattern(p.projectorSize));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
     simulator.projectImage(cv::Mat(p.projectorSize, CV_8UC1, cv::Scalar(255)));  // the session begins
     const auto& scenario = dynamic_cast<const PairCalibrationScenario&>(simulator.scenario());
     // Runs of frames showing the same props, at the rig's frame rate, over one cycle and a second beyond.
@@ -326,7 +319,7 @@ TEST(PairCalibrationScenario, HoldsSevenStillScenesAndMovesBetweenThem) {
 TEST(PairCalibrationScenario, TheUserBeginsWhenTheProjectorFirstShowsTheChessboard) {
     SimParameters p;
     p.scenario = "pair-calibration";
-    Simulator simulator(p, randomPattern(p.projectorSize));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
     const auto& scenario = dynamic_cast<const PairCalibrationScenario&>(simulator.scenario());
     const auto at = [&](double seconds) { return static_cast<std::uint64_t>(seconds * p.frameRate) & ~1ull; };
     // Before the dialogue shows anything the card lies on the table, however long that takes.
@@ -346,7 +339,7 @@ TEST(PairCalibrationScenario, TheUserBeginsWhenTheProjectorFirstShowsTheChessboa
 TEST(PairCalibrationScenario, ChessboardAndStripeOnEveryBoardPoseAgreeWithTheGeometry) {
     SimParameters p;
     p.scenario = "pair-calibration";
-    Simulator simulator(p, randomPattern(p.projectorSize));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 3));
     const core::Calibration& calibration = simulator.calibration();
     const auto& scenario = dynamic_cast<const PairCalibrationScenario&>(simulator.scenario());
     simulator.projectImage(chessboardImage(p.projectorSize));
@@ -393,7 +386,7 @@ TEST(PairCalibrationScenario, ChessboardAndStripeOnEveryBoardPoseAgreeWithTheGeo
 TEST(Props, AHandOverTheBoardIsSeenAboveItAndShadowsIt) {
     SimParameters p;
     const core::Calibration calibration = rigCalibration(p);
-    Renderer renderer(p, calibration, randomPattern(p.projectorSize));
+    Renderer renderer(p, calibration, test::randomPattern(p.projectorSize, 3));
     renderer.setContent(renderContent(ContentKind::White, calibration.displaySize, 1, 0));
     const PairCalibrationScenario scenario({calibration, 1, 1.0});
     const PairCalibrationScenario::Pose& pose = scenario.poses()[1];

@@ -16,16 +16,10 @@
 #include "sim/content.h"
 #include "sim/renderer.h"
 #include "sim/rig_geometry.h"
+#include "support/random_pattern.h"
 
 namespace everytouch::sim {
 namespace {
-
-cv::Mat randomPattern(cv::Size size, unsigned seed) {
-    cv::Mat pattern(size, CV_8UC1);
-    cv::RNG rng(seed);
-    rng.fill(pattern, cv::RNG::UNIFORM, 0, 2);
-    return pattern;
-}
 
 // Paper eq. 7: S = max over channels of C - C'.
 cv::Mat subtraction(const cv::Mat& positive, const cv::Mat& negative) {
@@ -88,7 +82,7 @@ protected:
         p.cameraColour = CameraColour::Rgb;
         p.ambientLux = 3.0;
         const core::Calibration calibration = rigCalibration(p);
-        const cv::Mat pattern = randomPattern(calibration.projectorSize, GetParam());
+        const cv::Mat pattern = test::randomPattern(calibration.projectorSize, GetParam());
         Renderer renderer(p, calibration, pattern);
         renderer.setContent(renderContent(ContentKind::Gray, calibration.displaySize, p.seed, 0));
 
@@ -154,7 +148,7 @@ INSTANTIATE_TEST_SUITE_P(Seeds, CodeParallax, ::testing::Values(1u, 2u));
 TEST(CodeOnTheTable, MatchesTheTableHomographyAndNotTenMillimetresUp) {
     SimParameters p;
     const core::Calibration calibration = rigCalibration(p);
-    const cv::Mat pattern = randomPattern(calibration.projectorSize, 5);
+    const cv::Mat pattern = test::randomPattern(calibration.projectorSize, 5);
     Renderer renderer(p, calibration, pattern);
     renderer.setContent(renderContent(ContentKind::Photo, calibration.displaySize, 5, 0));
     const double exposure = renderer.meterExposureMs(p.ambientLux);

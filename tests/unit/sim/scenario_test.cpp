@@ -4,16 +4,10 @@
 #include <gtest/gtest.h>
 
 #include "sim/simulator.h"
+#include "support/random_pattern.h"
 
 namespace everytouch::sim {
 namespace {
-
-cv::Mat randomPattern(cv::Size size, unsigned seed) {
-    cv::Mat pattern(size, CV_8UC1);
-    cv::RNG rng(seed);
-    rng.fill(pattern, cv::RNG::UNIFORM, 0, 2);
-    return pattern;
-}
 
 struct Tally {
     int touches = 0;             // presented fingertips touching, over all sampled frames
@@ -26,7 +20,7 @@ Tally play(const std::string& name, std::uint64_t seed) {
     SimParameters p;
     p.scenario = name;
     p.seed = seed;
-    Simulator simulator(p, randomPattern(p.projectorSize, static_cast<unsigned>(seed)));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, static_cast<unsigned>(seed)));
     const double cycle = simulator.scenario().cycleSeconds();
     Tally tally;
     core::Frame frame;
@@ -69,7 +63,7 @@ TEST(Scenario, UnknownNameListsTheKnownOnes) {
     SimParameters p;
     p.scenario = "juggle";
     try {
-        Simulator simulator(p, randomPattern(p.projectorSize, 1));
+        Simulator simulator(p, test::randomPattern(p.projectorSize, 1));
         FAIL() << "no exception";
     } catch (const std::invalid_argument& error) {
         EXPECT_NE(std::string(error.what()).find("grid35, drag, multitouch, hover, palm, idle, demo"),
@@ -124,7 +118,7 @@ TEST(Simulator, FramesAreAPureFunctionOfParametersSeedAndTime) {
     SimParameters p;
     p.scenario = "grid35";
     p.seed = 9;
-    const cv::Mat pattern = randomPattern(p.projectorSize, 9);
+    const cv::Mat pattern = test::randomPattern(p.projectorSize, 9);
     Simulator first(p, pattern), second(p, pattern);
     core::Frame a, b;
     FrameTruth truthA, truthB;
@@ -150,7 +144,7 @@ TEST(Simulator, MovingHandsAreBlurredOverTheExposureStillOnesAreNot) {
     SimParameters p;
     p.scenario = "grid35";
     p.seed = 6;
-    const cv::Mat pattern = randomPattern(p.projectorSize, 6);
+    const cv::Mat pattern = test::randomPattern(p.projectorSize, 6);
     Simulator blurred(p, pattern);
     p.motionSamples = 1;
     Simulator sharp(p, pattern);
@@ -184,7 +178,7 @@ TEST(Simulator, AmbientLightChangesMidSession) {
     p.ambientLux = 150.0;
     p.ambientChangeLux = 3.0;
     p.ambientChangeAtS = 1.0;
-    Simulator simulator(p, randomPattern(p.projectorSize, 1));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 1));
     core::Frame before, after;
     FrameTruth truth;
     simulator.render(100, before, truth);
@@ -201,7 +195,7 @@ TEST(Simulator, MeteringPutsWhiteContentAtTheTargetLevel) {
     p.scenario = "idle";
     p.content = "white";
     p.vignettingPower = 0.0;
-    Simulator simulator(p, randomPattern(p.projectorSize, 1));
+    Simulator simulator(p, test::randomPattern(p.projectorSize, 1));
     core::Frame frame;
     FrameTruth truth;
     simulator.render(0, frame, truth);
