@@ -84,6 +84,10 @@ public:
     // image's edge does. Empty before setRig.
     const cv::Mat& judgedRegion() const { return judgedRegion_; }
 
+    // The display's bounding box in the camera: whatever the method decides lies within it. Empty before
+    // setRig.
+    const cv::Rect& displayBox() const { return displayBox_; }
+
     // Camera pixels per millimetre on the table near the image centre (from the calibration).
     double pixelsPerMm() const { return pixelsPerMm_; }
 

@@ -1,5 +1,6 @@
 #include "core/touch_pipeline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -63,6 +64,7 @@ TouchPipeline::TouchPipeline(const DetectionOptions& options)
 
 void TouchPipeline::reset() {
     tracker_.reset();
+    stillScene_.reset();
     rememberedCount_ = 0;
     result_.contacts.clear();
     result_.fingertips.clear();
@@ -78,6 +80,9 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
     const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
     options_.fingertips.fingerWidthPx = rig.fingerWidthPx;
     options_.fingertips.padDrop = rig.padDrop;
+    // Blocks a quarter of a finger wide: a fingertip that moves changes several of them.
+    stillScene_.setRegion(segmenter_.displayBox(),
+                          std::clamp(static_cast<int>(std::lround(rig.fingerWidthPx / 4.0)), 2, 64));
     const cv::Size2d displayMm = calibration.displaySizeMm();
     displayPixelsPerMm_ = calibration.displaySize.width / displayMm.width;
     rigCalibration_ = calibration;
@@ -87,6 +92,7 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
 
 const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
     result_.frameIndex = pair.latest().index;
+    result_.sceneStill = false;
     result_.timestampUs = pair.latest().timestampUs;
     computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
     result_.handMask.create(result_.texture.size(), CV_8UC1);
@@ -110,9 +116,14 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     adoptRig(settings);
     result_.detecting = true;
     result_.idleReason.clear();
-    segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
-    findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_,
-                   segmenter_.judgedRegion());
+    // The last pair's mask and fingertips stay in place while the scene stands still.
+    result_.sceneStill = stillScene_.matchesReference(result_.texture, result_.subtraction);
+    if (!result_.sceneStill) {
+        segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
+        findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_,
+                       segmenter_.judgedRegion());
+        stillScene_.adoptAsReference();
+    }
     measureFingertips(pair, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);

@@ -14,6 +14,7 @@
 #include "core/fingertips.h"
 #include "core/frame.h"
 #include "core/hand_segmentation.h"
+#include "core/still_scene.h"
 #include "core/surface_height.h"
 
 namespace everytouch::core {
@@ -72,6 +73,9 @@ struct PipelineResult {
     cv::Mat subtraction;     // S, CV_16SC1
     cv::Mat texture;         // T, the frames' type
     cv::Mat handMask;        // CV_8UC1, 255 on the hand; all 0 when not detecting
+    // The scene matched the last segmented pair within the camera's noise (core/still_scene.h): the mask
+    // and the fingertips are that pair's. Heights and tracking ran on this pair.
+    bool sceneStill = false;
     std::vector<FingertipObservation> fingertips;
     Contacts contacts;  // tracked, in display pixels
 };
@@ -109,6 +113,7 @@ private:
 
     DetectionOptions options_;
     HandSegmenter segmenter_;
+    StillScene stillScene_;
     SurfaceHeight height_;
     ContactTracker tracker_;
     FingertipScratch fingertipScratch_;

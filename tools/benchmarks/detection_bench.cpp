@@ -47,9 +47,14 @@ Scene renderScene(const char* scenario, double startS, int pairs) {
     return scene;
 }
 
-// grid35 at 1.9 s: one hand with its forearm, the index finger pointing; idle: nothing but content.
+// grid35 at 1.9 s: one hand with its forearm, the index finger pointing and held still; at 2.3 s on its way
+// to the next circle; idle: nothing but content.
 const Scene& oneHand() {
     static const Scene scene = renderScene("grid35", 1.9, 8);
+    return scene;
+}
+const Scene& movingHand() {
+    static const Scene scene = renderScene("grid35", 2.3, 8);
     return scene;
 }
 const Scene& noHand() {
@@ -167,9 +172,8 @@ void BM_HeightOfOneFingertip(benchmark::State& state) {
 }
 BENCHMARK(BM_HeightOfOneFingertip)->Unit(benchmark::kMicrosecond);
 
-void BM_TouchPipelineOneHand(benchmark::State& state) {
+void runPipeline(benchmark::State& state, const Scene& scene) {
     cv::setNumThreads(1);
-    const Scene& scene = oneHand();
     core::TouchPipeline pipeline;
     const core::PipelineSettings settings{scene.calibration, scene.pattern, 0.0};
     // The scene's pairs over and over, their timestamps moved on each round as a camera's would be.
@@ -198,6 +202,23 @@ void BM_TouchPipelineOneHand(benchmark::State& state) {
     }
     timings.report(state);
 }
+
+// A hand that moves: every pair is segmented.
+void BM_TouchPipelineOneHand(benchmark::State& state) {
+    runPipeline(state, movingHand());
+}
 BENCHMARK(BM_TouchPipelineOneHand)->Unit(benchmark::kMillisecond);
+
+// A hand held still and the table with nobody at it: the scene stands still, and the segmentation need not
+// run again.
+void BM_TouchPipelineStillHand(benchmark::State& state) {
+    runPipeline(state, oneHand());
+}
+BENCHMARK(BM_TouchPipelineStillHand)->Unit(benchmark::kMillisecond);
+
+void BM_TouchPipelineNoHand(benchmark::State& state) {
+    runPipeline(state, noHand());
+}
+BENCHMARK(BM_TouchPipelineNoHand)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -49,5 +49,30 @@ TEST(SteadyStateAllocation, ThePipelineAllocatesNothingPerPairOnceWarm) {
         << "allocations while processing " << pairs.size() << " pairs";
 }
 
+TEST(SteadyStateAllocation, AStillSceneAllocatesNothingEither) {
+    cv::setNumThreads(1);
+    sim::SimParameters parameters;
+    parameters.scenario = "grid35";
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    // A hand held still above a circle: after the first pairs the segmentation is skipped.
+    const std::vector<FramePair> pairs = renderPairs(simulator, 1.9, 12);
+    TouchPipeline pipeline;
+    const PipelineSettings settings{simulator.calibration(), simulator.pattern(), 0.0};
+    for (int round = 0; round < 2; ++round) {
+        pipeline.reset();
+        for (const FramePair& pair : pairs)
+            pipeline.process(pair, settings);
+    }
+
+    pipeline.reset();
+    int still = 0;
+    const std::uint64_t before = test::allocationCount();
+    for (const FramePair& pair : pairs)
+        still += pipeline.process(pair, settings).sceneStill ? 1 : 0;
+    EXPECT_EQ(test::allocationCount() - before, 0u)
+        << "allocations while processing " << pairs.size() << " pairs";
+    EXPECT_GT(still, 0) << "the test needs pairs of a still scene";
+}
+
 }  // namespace
 }  // namespace everytouch::core

@@ -120,7 +120,8 @@ TEST(ContactTrackerOnTheTouchscreen, ATouchTurningIntoAPalmIsCancelledNotLifted)
     TrackerToTouchscreen screen;
     // A finger comes down beside a resting palm, and a second finger touches elsewhere.
     for (int f = 0; f < 20; ++f)
-        screen.frame({observedPalm(60, 200), observedFinger(150, 120, 6.0 - 0.5 * f), observedFinger(220, 90, 0.0)});
+        screen.frame(
+            {observedPalm(60, 200), observedFinger(150, 120, 6.0 - 0.5 * f), observedFinger(220, 90, 0.0)});
     EXPECT_EQ(screen.reader.downs, 2);
     EXPECT_EQ(screen.reader.buttonTouch, 1);
     // The hand flattens: the first finger is now seen as part of a palm, then the hand lifts away.
