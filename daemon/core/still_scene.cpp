@@ -18,6 +18,9 @@ constexpr double kLowerQuartileDeviationPerSigma = 0.3186393639643752;
 constexpr std::size_t kMinSamples = 100;
 // The noise is learned from every kLearningInterval-th pair: it changes with the light, over seconds.
 constexpr int kLearningInterval = 8;
+// Each estimate joins an exponential average with this weight before the lowest is kept: the lowest of many
+// raw estimates would sit a few of their standard errors below the noise.
+constexpr double kSmoothing = 0.2;
 
 // Adds a row of pixels to the column sums of a block row (the sums hold up to 257 rows of 8-bit values).
 void addRow(const uchar* row, std::uint16_t* sums, int n) {
@@ -88,6 +91,8 @@ void StillScene::reset() {
     measuredPairs_ = 0;
     hasReference_ = false;
     for (auto& group : noise_)
+        std::fill(std::begin(group), std::end(group), -1.0);
+    for (auto& group : smoothedNoise_)
         std::fill(std::begin(group), std::end(group), -1.0);
 }
 
@@ -180,8 +185,10 @@ void StillScene::learnNoise(const std::vector<float>& earlier) {
             for (float& d : differences)
                 d = std::abs(d - centre);
             const double spread = quantile(differences, 0.25) / kLowerQuartileDeviationPerSigma;
+            double& smoothed = smoothedNoise_[group][band];
+            smoothed = smoothed < 0.0 ? spread : smoothed + kSmoothing * (spread - smoothed);
             double& noise = noise_[group][band];
-            noise = noise < 0.0 ? spread : std::min(noise, spread);
+            noise = noise < 0.0 ? smoothed : std::min(noise, smoothed);
         }
 }
 

@@ -66,7 +66,8 @@ private:
     std::vector<std::uint16_t> textureColumns_;
     std::vector<std::int32_t> subtractionColumns_;
     std::vector<float> differences_[2][kBands];
-    double noise_[2][kBands] = {};  // 0 where not learned
+    double smoothedNoise_[2][kBands] = {};
+    double noise_[2][kBands] = {};  // negative where not learned
 };
 
 }  // namespace everytouch::core
