@@ -642,13 +642,14 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             if (!nearHand)
                 continue;
             const cv::Rect block(bx * blockPx, by * blockPx, blockPx, blockPx);
-            if (pure(by, bx)) {
-                fill(mask(block), 255);
-                continue;
-            }
+            // Deep inside the hand every lit pixel is hand. The lit test below still applies there: the
+            // shadow a finger high above the table casts beside itself (as wide as the code's parallax at its
+            // height: 6 px at 35 mm) lies within the reach of windows that see the finger's code, and so do
+            // its blocks.
+            const bool inside = pure(by, bx);
             // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
             NearestColour hand, other, looseHand;
-            for (int dy = -kColourReach; dy <= kColourReach; ++dy)
+            for (int dy = -kColourReach; dy <= kColourReach && !inside; ++dy)
                 for (int dx = -kColourReach; dx <= kColourReach; ++dx) {
                     const int y = by + dy, x = bx + dx;
                     const uchar n = classAt(y, x);
@@ -692,6 +693,10 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     }
                     if (c != Grown && localSum < litSum) {
                         out[x] = 0;
+                        continue;
+                    }
+                    if (inside) {
+                        out[x] = 255;
                         continue;
                     }
                     float colour[3], pixel[3];

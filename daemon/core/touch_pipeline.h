@@ -73,8 +73,8 @@ struct PipelineResult {
     cv::Mat subtraction;     // S, CV_16SC1
     cv::Mat texture;         // T, the frames' type
     cv::Mat handMask;        // CV_8UC1, 255 on the hand; all 0 when not detecting
-    // The scene matched the last segmented pair within the camera's noise (core/still_scene.h): the mask
-    // and the fingertips are that pair's. Heights and tracking ran on this pair.
+    // The scene, with no fingertip in it, matched the last segmented pair within the camera's noise
+    // (core/still_scene.h): the mask is that pair's. Tracking ran on this pair.
     bool sceneStill = false;
     std::vector<FingertipObservation> fingertips;
     Contacts contacts;  // tracked, in display pixels

@@ -1,9 +1,12 @@
 // The code segmentation on rendered frames: what the code alone cannot tell, colour does.
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "core/code_image.h"
+#include "core/fingertips.h"
 #include "core/geometry.h"
 #include "core/hand_segmentation.h"
 #include "sim/simulator.h"
@@ -12,8 +15,10 @@ namespace everytouch::core {
 namespace {
 
 struct DiskScore {
-    int truth = 0, found = 0;  // hand pixels of the truth near touching pads, and how many the mask has
+    int truth = 0, found = 0;  // hand pixels of the truth near the pads, and how many the mask has
+    int marked = 0;            // pixels the mask has near the pads
     double recall() const { return truth ? static_cast<double>(found) / truth : 0.0; }
+    double precision() const { return marked ? static_cast<double>(found) / marked : 0.0; }
 };
 
 // The hand's pixels within `radiusMm` of every touching pad, as the truth and the segmentation see them, over
@@ -83,8 +88,83 @@ TEST(HandSegmentation, AFingerSlidingFlatOnTheTableKeepsItsWidth) {
     const DiskScore score = scoreTouchingEnds("drag", SegmentationOptions{}, 15.0);
     ASSERT_GT(score.truth, 10000) << "the test needs a sliding finger in view";
     // 0.84 when the table's colour was sampled only just beyond the reach (none found inside such a finger);
-    // 0.91 as measured.
-    EXPECT_GE(score.recall(), 0.88) << score.found << " of " << score.truth << " pixels";
+    // 0.91 then, and 0.88 since pixels deep inside the hand also need projector light, as measured: a
+    // sliding finger's edges, where the two frames differ, count as unlit.
+    EXPECT_GE(score.recall(), 0.86) << score.found << " of " << score.truth << " pixels";
+}
+
+TEST(HandSegmentation, AFingerPassingHighIsFoundInEveryPair) {
+    // A finger passing high above the table casts the projector's shadow beside itself, as wide as the code's
+    // parallax at that height, and sweeps it over the table between the two frames of a pair. The blocks
+    // there see the finger's code in their windows, but the pixels get no projector light: kept, they widened
+    // the silhouette beyond a finger's width, and the fingertip was lost in every other pair or so.
+    sim::SimParameters parameters;
+    parameters.scenario = "grid35";
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    const Calibration& calibration = simulator.calibration();
+    HandSegmenter segmenter(SegmentationOptions{});
+    segmenter.setRig(calibration, simulator.pattern());
+    const FingertipOptions fingertipOptions = rigFingertipOptions(calibration);
+    const double radiusPx = 16.0 * segmenter.pixelsPerMm();
+    FingertipScratch scratch;
+    Fingertips fingertips;
+
+    int presented = 0, found = 0;
+    DiskScore score;
+    Frame older, newer;
+    sim::FrameTruth truth, olderTruth;
+    cv::Mat subtraction, texture, mask;
+    const double cycle = simulator.scenario().cycleSeconds();
+    constexpr int kSamples = 480;
+    for (int i = 0; i < kSamples; ++i) {
+        // Consecutive samples start on frames of either polarity.
+        const auto index = static_cast<std::uint64_t>(cycle * i / kSamples * parameters.frameRate);
+        simulator.render(index, older, olderTruth);
+        simulator.render(index + 1, newer, truth);
+        const bool olderPositive = older.polarity == Polarity::Positive;
+        computeSubtractionAndTexture(FramePair{olderPositive ? older : newer, olderPositive ? newer : older},
+                                     subtraction, texture);
+        segmenter.segment(texture, subtraction, mask);
+        findFingertips(mask, fingertipOptions, scratch, fingertips, segmenter.judgedRegion());
+        for (const sim::FingertipTruth& finger : truth.fingertips) {
+            if (!finger.presented || finger.heightMm < 25.0)
+                continue;
+            const Eigen::Vector2d pad =
+                projectPoint(calibration.cameraMatrix, calibration.tableToCamera, finger.pad);
+            // A finger entering over the display's edge shows its end alone: it counts once its last joint is
+            // over the display.
+            bool wellInside = true;
+            for (int k = 0; k < 8; ++k) {
+                const double angle = k * M_PI / 4, reach = 2.0 * fingertipOptions.fingerWidthPx;
+                const cv::Point pixel(static_cast<int>(pad.x() + reach * std::cos(angle)),
+                                      static_cast<int>(pad.y() + reach * std::sin(angle)));
+                wellInside = wellInside && cv::Rect(0, 0, mask.cols, mask.rows).contains(pixel) &&
+                             segmenter.judgedRegion().at<uchar>(pixel);
+            }
+            if (!wellInside)
+                continue;
+            ++presented;
+            found += std::any_of(fingertips.begin(), fingertips.end(), [&](const Fingertip& tip) {
+                return (tip.pad - pad).norm() <= fingertipOptions.fingerWidthPx;
+            });
+            for (int y = static_cast<int>(pad.y() - radiusPx); y <= static_cast<int>(pad.y() + radiusPx); ++y)
+                for (int x = static_cast<int>(pad.x() - radiusPx); x <= static_cast<int>(pad.x() + radiusPx);
+                     ++x)
+                    if ((Eigen::Vector2d(x, y) - pad).norm() <= radiusPx) {
+                        const bool hand = truth.handMask.at<uchar>(y, x) != 0,
+                                   marked = mask.at<uchar>(y, x) != 0;
+                        score.truth += hand;
+                        score.found += hand && marked;
+                        score.marked += marked;
+                    }
+        }
+    }
+    ASSERT_GT(presented, 100) << "the test needs fingers passing high over the display";
+    // 101 of 118 and a precision of 0.93 within 16 mm of the pads when only the outline's pixels needed
+    // projector light; 109 and 0.96 as measured. The recall there fell from 0.92 to 0.83: a moving finger's
+    // edges, where the two frames differ, are taken for unlit too.
+    EXPECT_GE(found, 0.9 * presented) << found << " of " << presented << " fingers found";
+    EXPECT_GE(score.precision(), 0.95) << score.found << " of " << score.marked << " pixels marked";
 }
 
 }  // namespace

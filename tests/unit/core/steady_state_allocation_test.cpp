@@ -54,8 +54,8 @@ TEST(SteadyStateAllocation, AStillSceneAllocatesNothingEither) {
     sim::SimParameters parameters;
     parameters.scenario = "grid35";
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    // A hand held still above a circle: after the first pairs the segmentation is skipped.
-    const std::vector<FramePair> pairs = renderPairs(simulator, 1.9, 12);
+    // The table before the hand comes in: after the first pairs the segmentation is skipped.
+    const std::vector<FramePair> pairs = renderPairs(simulator, 0.1, 12);
     TouchPipeline pipeline;
     const PipelineSettings settings{simulator.calibration(), simulator.pattern(), 0.0};
     for (int round = 0; round < 2; ++round) {
