@@ -121,7 +121,7 @@ cv::Mat renderContactSheet(const io::Recording& recording, const std::vector<std
         putLabel(texture, "frame " + std::to_string(pair.pair.latest().index), cv::Point(6, 18), kTextColour);
 
         cv::Mat truth = placeCell(sheet, pair.truthMask, row, 1, cell);
-        findFingertips(pair.truthMask, tips);
+        findFingertips(pair.truthMask, cv::Mat(), tips);
         drawTips(truth, tips, options.scale);
         drawTruth(truth, pair.fingers, options.scale);
 
@@ -131,7 +131,7 @@ cv::Mat renderContactSheet(const io::Recording& recording, const std::vector<std
                 continue;
             method.segment({pair.texture, pair.subtraction, pair.pair}, mask);
             cv::Mat target = placeCell(sheet, errorImage(mask, pair.truthMask), row, column++, cell);
-            findFingertips(mask, tips);
+            findFingertips(mask, method.judged, tips);
             drawTips(target, tips, options.scale);
             drawTruth(target, pair.fingers, options.scale);
             const PixelCounts counts = countPixels(mask, pair.truthMask);

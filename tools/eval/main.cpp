@@ -131,9 +131,9 @@ int runSegmentation(const SegmentationArguments& arguments) {
                              "no fingertip finder for this rig: " + *problem);
     core::FingertipScratch scratch;
     core::Fingertips found;
-    const eval::FingertipFinder findFingertips = [&](const cv::Mat& mask,
+    const eval::FingertipFinder findFingertips = [&](const cv::Mat& mask, const cv::Mat& judged,
                                                      std::vector<Eigen::Vector2d>& pads) {
-        core::findFingertips(mask, fingertipOptions, scratch, found);
+        core::findFingertips(mask, fingertipOptions, scratch, found, judged);
         pads.clear();
         for (const core::Fingertip& fingertip : found)
             pads.push_back(fingertip.pad);

@@ -11,9 +11,10 @@ namespace everytouch::eval {
 
 namespace {
 
-void scoreFingertips(const PairWithTruth& pair, const cv::Mat& mask, const FingertipFinder& findFingertips,
-                     std::vector<Eigen::Vector2d>& tips, FingertipScore& score) {
-    findFingertips(mask, tips);
+void scoreFingertips(const PairWithTruth& pair, const cv::Mat& mask, const cv::Mat& judged,
+                     const FingertipFinder& findFingertips, std::vector<Eigen::Vector2d>& tips,
+                     FingertipScore& score) {
+    findFingertips(mask, judged, tips);
     score.add(pair.fingers.size(), tips.size(), matchFingertips(pair.fingers, tips));
 }
 
@@ -47,7 +48,8 @@ SegmentationReport evaluateSegmentation(const io::Recording& recording, const st
         if (cv::countNonZero(pair.truthMask & display) > 0)
             ++report.pairsWithHandOnDisplay;
         if (report.fingertipTruth)
-            scoreFingertips(pair, pair.truthMask, findFingertips, tips, report.truthMaskFingertips);
+            scoreFingertips(pair, pair.truthMask, cv::Mat(), findFingertips, tips,
+                            report.truthMaskFingertips);
         for (std::size_t m = 0; m < methods.size(); ++m) {
             if (methods[m].unavailable)
                 continue;
@@ -60,7 +62,7 @@ SegmentationReport evaluateSegmentation(const io::Recording& recording, const st
             result.pixels.add(countPixels(mask, pair.truthMask));
             result.displayPixels.add(countPixels(mask, pair.truthMask, display));
             if (report.fingertipTruth)
-                scoreFingertips(pair, mask, findFingertips, tips, result.fingertips);
+                scoreFingertips(pair, mask, methods[m].judged, findFingertips, tips, result.fingertips);
         }
     }
     return report;

@@ -16,8 +16,10 @@
 namespace everytouch::eval {
 
 // The fingertips found on a hand mask (CV_8UC1, 255 = hand): their pads, where a touch is reported, raw
-// camera pixels.
-using FingertipFinder = std::function<void(const cv::Mat& mask, std::vector<Eigen::Vector2d>& pads)>;
+// camera pixels. judged: what the method decided (SegmentationMethod::judged; empty: the whole mask), whose
+// edge cuts hands as the image's edge does.
+using FingertipFinder =
+    std::function<void(const cv::Mat& mask, const cv::Mat& judged, std::vector<Eigen::Vector2d>& pads)>;
 
 struct MethodResult {
     std::string name;

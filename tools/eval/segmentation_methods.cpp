@@ -33,6 +33,7 @@ SegmentationMethod pipelineMethod(const io::Recording& recording, core::Segmenta
     SegmentationMethod method;
     method.name = name;
     method.description = description;
+    method.judged = segmenter->judgedRegion();
     method.segment = [segmenter](const SegmentationInput& input, cv::Mat& mask) {
         segmenter->segment(input.texture, input.subtraction, mask);
     };

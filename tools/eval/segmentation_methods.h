@@ -24,9 +24,13 @@ struct SegmentationInput {
 using SegmentFunction = std::function<void(const SegmentationInput& input, cv::Mat& mask)>;
 
 struct SegmentationMethod {
-    std::string name;                        // short, for the table and the contact sheet
-    std::string description;                 // what it is and how it was set up for this recording
-    SegmentFunction segment;                 // empty when unavailable
+    std::string name;         // short, for the table and the contact sheet
+    std::string description;  // what it is and how it was set up for this recording
+    SegmentFunction segment;  // empty when unavailable
+    // CV_8UC1, the camera's size: nonzero where the method decides hand or not; empty when it decides
+    // everywhere. The pipeline's fingertip finder gets it, so fingertips are scored as the pipeline finds
+    // them.
+    cv::Mat judged;
     std::optional<std::string> unavailable;  // why it cannot run on this recording
 };
 

@@ -65,8 +65,9 @@ TEST(EvaluateSegmentation, ScoresEveryPairAndTheFingertipsOnEachMask) {
     const core::FingertipOptions options = core::rigFingertipOptions(recording.rig().calibration, 16.0);
     core::FingertipScratch scratch;
     core::Fingertips found;
-    const FingertipFinder finder = [&](const cv::Mat& mask, std::vector<Eigen::Vector2d>& pads) {
-        core::findFingertips(mask, options, scratch, found);
+    const FingertipFinder finder = [&](const cv::Mat& mask, const cv::Mat& judged,
+                                       std::vector<Eigen::Vector2d>& pads) {
+        core::findFingertips(mask, options, scratch, found, judged);
         pads.clear();
         for (const core::Fingertip& fingertip : found)
             pads.push_back(fingertip.pad);
@@ -126,7 +127,9 @@ TEST(SegmentationMethods, SayWhyTheyCannotRunOnARecording) {
 
     // Those that can run are scored; the others are reported as not run.
     const TruthToCamera toCamera(rig.calibration, 16.0);
-    const FingertipFinder none = [](const cv::Mat&, std::vector<Eigen::Vector2d>& pads) { pads.clear(); };
+    const FingertipFinder none = [](const cv::Mat&, const cv::Mat&, std::vector<Eigen::Vector2d>& pads) {
+        pads.clear();
+    };
     const SegmentationReport report = evaluateSegmentation(recording, "gray", methods, none, toCamera, 16.0);
     EXPECT_EQ(report.pairs, 3);
     EXPECT_EQ(report.channels, 1);
