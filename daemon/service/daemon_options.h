@@ -6,13 +6,13 @@
 #include <string>
 #include <vector>
 
-#ifndef EVERYTOUCH_SYSCONFDIR
-#define EVERYTOUCH_SYSCONFDIR "/etc"
+#ifndef EVERYTOUCH_CONFIG_DIR
+#define EVERYTOUCH_CONFIG_DIR "/etc/everytouch"
 #endif
 
 namespace everytouch::service {
 
-inline constexpr const char* kDefaultConfigPath = EVERYTOUCH_SYSCONFDIR "/everytouch/everytouchd.conf";
+inline constexpr const char* kDefaultConfigPath = EVERYTOUCH_CONFIG_DIR "/everytouchd.conf";
 // The rig of a daemon started by hand with no camera configured: the simulator, to try everything out.
 inline constexpr const char* kHandRunRig = "sim:demo";
 
