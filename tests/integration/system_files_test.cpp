@@ -71,6 +71,33 @@ TEST(SystemFiles, EveryFileIsInstalledWhereTheSystemLooksForItWhateverThePrefix)
     }
 }
 
+TEST(SystemFiles, TheDebianPackageHoldsTheInstallAndLintianFindsNoError) {
+    test::TempDir out;
+    const test::ProcessResult packed = test::runProcess(
+        {CPACK_COMMAND, "-G", "DEB", "--config", BUILD_DIR "/CPackConfig.cmake", "-B", out.path()});
+    ASSERT_EQ(packed.exitCode, 0) << packed.out << packed.err;
+    std::filesystem::path deb;
+    for (const auto& entry : std::filesystem::directory_iterator(out.path()))
+        if (entry.path().extension() == ".deb")
+            deb = entry.path();
+    ASSERT_FALSE(deb.empty()) << packed.out;
+
+    const test::ProcessResult contents = test::runProcess({"/usr/bin/dpkg-deb", "--contents", deb});
+    for (const std::string path :
+         {"./usr/sbin/everytouchd", "./usr/bin/everytouch-calib",
+          "./usr/share/dbus-1/system.d/org.everytouch.Daemon1.conf", "./etc/everytouch/everytouchd.conf",
+          "." UNIT_DIR "/everytouchd.service", "./usr/share/doc/everytouch/copyright",
+          "./usr/share/man/man8/everytouchd.8.gz"})
+        EXPECT_THAT(contents.out, HasSubstr(" " + path + "\n"));
+    const test::ProcessResult control = test::runProcess({"/usr/bin/dpkg-deb", "--field", deb, "Depends"});
+    EXPECT_THAT(control.out, HasSubstr("libevdev2"));
+    EXPECT_THAT(control.out, HasSubstr("libsystemd0"));
+
+    // Debian's own checker: warnings are allowed (a tool without a manual page), errors are not.
+    const test::ProcessResult lint = test::runProcess({"/usr/bin/lintian", "--tag-display-limit", "0", deb});
+    EXPECT_EQ(lint.exitCode, 0) << lint.out << lint.err;
+}
+
 // The keys the example shows commented out, as "[Section] Key".
 std::set<std::string> commentedKeys(const std::string& example) {
     std::set<std::string> keys;
