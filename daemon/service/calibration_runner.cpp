@@ -54,8 +54,12 @@ std::optional<std::vector<core::FramePair>> CalibrationRunner::capture(std::size
     std::unique_lock lock(handover->mutex);
     while (!handover->pairs && !cancelled_ && Clock::now() < deadline)
         handover->arrived.wait_for(lock, std::chrono::milliseconds(100));
-    if (!handover->pairs)
-        tap_.cancel(ticket);
+    if (handover->pairs)
+        return std::move(handover->pairs);
+    // Cancelling waits for a delivery under way, which needs the handover's lock; what it delivered is used.
+    lock.unlock();
+    tap_.cancel(ticket);
+    lock.lock();
     return std::move(handover->pairs);
 }
 

@@ -1,5 +1,7 @@
 #include "service/frame_tap.h"
 
+#include <algorithm>
+
 namespace everytouch::service {
 
 namespace {
@@ -36,9 +38,13 @@ FrameTap::Ticket FrameTap::request(std::size_t pairs, Done done, bool withDetect
 }
 
 void FrameTap::cancel(Ticket ticket) {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     pending_.erase(ticket);
     wanted_ = !pending_.empty();
+    if (deliveringThread_ == std::this_thread::get_id())
+        return;
+    delivered_.wait(
+        lock, [&] { return std::find(delivering_.begin(), delivering_.end(), ticket) == delivering_.end(); });
 }
 
 void FrameTap::offer(const core::FramePair& pair, const core::PipelineResult* detection) {
@@ -58,13 +64,24 @@ void FrameTap::offer(const core::FramePair& pair, const core::PipelineResult* de
                 ++it;
                 continue;
             }
+            delivering_.push_back(it->first);
             filled.push_back(std::move(it->second));
             it = pending_.erase(it);
         }
         wanted_ = !pending_.empty();
+        if (!filled.empty())
+            deliveringThread_ = std::this_thread::get_id();
     }
+    if (filled.empty())
+        return;
     for (Pending& request : filled)
         request.done(std::move(request.pairs));
+    {
+        std::lock_guard lock(mutex_);
+        delivering_.clear();
+        deliveringThread_ = {};
+    }
+    delivered_.notify_all();
 }
 
 }  // namespace everytouch::service

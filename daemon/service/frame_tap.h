@@ -1,12 +1,14 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <thread>
 #include <vector>
 
 #include "core/frame.h"
@@ -33,7 +35,9 @@ public:
     // Asks for the next `pairs` pairs; `done` receives them, with a copy of what detection made of each when
     // `withDetection` (a snapshot shows it; a calibration step needs only the frames).
     Ticket request(std::size_t pairs, Done done, bool withDetection = false);
-    // Withdraws a request; `done` will not run unless it already has.
+    // Withdraws a request; `done` will not run unless it already has. When it is running on the pipeline
+    // thread, waits until it has returned, so that what it uses may go once cancel returns (unless called
+    // from that `done` itself).
     void cancel(Ticket ticket);
 
     // Pipeline thread: a new pair was formed and, unless `detection` is null, processed.
@@ -51,6 +55,10 @@ private:
     std::mutex mutex_;
     Ticket nextTicket_ = 1;
     std::map<Ticket, Pending> pending_;
+    // The requests whose `done` runs now, outside the lock, on the thread delivering them.
+    std::vector<Ticket> delivering_;
+    std::thread::id deliveringThread_;
+    std::condition_variable delivered_;
 };
 
 }  // namespace everytouch::service
