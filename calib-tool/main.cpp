@@ -113,7 +113,8 @@ int snapshot(const std::string& what, const std::filesystem::path& file) {
         ::unlink(temporary.c_str());
         return report(*failure);
     }
-    if (::rename(temporary.c_str(), file.c_str()) < 0) {
+    // On disk before it takes the name: a crash then leaves the old file or the new one, never an empty one.
+    if (::fsync(fd.get()) < 0 || ::rename(temporary.c_str(), file.c_str()) < 0) {
         const int error = errno;
         ::unlink(temporary.c_str());
         return report(

@@ -1,7 +1,5 @@
 #pragma once
 
-#include <libevdev/libevdev-uinput.h>
-#include <libevdev/libevdev.h>
 #include <systemd/sd-bus.h>
 #include <systemd/sd-event.h>
 #include <unistd.h>
@@ -12,7 +10,8 @@
 namespace everytouch::io {
 
 // Owners for C library handles: `UniqueHandle<sd_bus, sd_bus_flush_close_unref>` and the like, so that no
-// handle is ever released by hand. Aliases for the libraries the adapters use follow the template.
+// handle is ever released by hand. Aliases for sd-bus, sd-event and file descriptors follow the template;
+// libevdev's are in io/evdev_handles.h.
 template <auto releaseFunction>
 struct HandleDeleter {
     template <typename T>
@@ -23,10 +22,6 @@ struct HandleDeleter {
 
 template <typename T, auto releaseFunction>
 using UniqueHandle = std::unique_ptr<T, HandleDeleter<releaseFunction>>;
-
-using UniqueLibevdev = UniqueHandle<libevdev, libevdev_free>;
-// Destroying it removes the uinput device and closes /dev/uinput.
-using UniqueLibevdevUinput = UniqueHandle<libevdev_uinput, libevdev_uinput_destroy>;
 
 // sd-bus and sd-event (libsystemd). A bus is flushed before it closes, so queued replies still go out.
 using Bus = UniqueHandle<sd_bus, sd_bus_flush_close_unref>;

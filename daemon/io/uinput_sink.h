@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "core/calibration.h"
-#include "io/handles.h"
+#include "io/evdev_handles.h"
 #include "io/multitouch_encoder.h"
 #include "io/touch_sink.h"
 

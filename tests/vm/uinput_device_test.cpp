@@ -19,7 +19,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "io/handles.h"
+#include "io/evdev_handles.h"
 #include "io/recording.h"
 #include "io/touch_log.h"
 #include "io/touchscreen_axes.h"
