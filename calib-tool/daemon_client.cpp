@@ -123,15 +123,15 @@ std::variant<DaemonClient::Display, Failure> DaemonClient::display() {
     Display display;
     io::UniqueBusError error;
     sd_bus_message* raw = nullptr;
-    int r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "DisplaySize",
-                                error.get(), &raw, "(uu)");
+    int r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                bus::kPropertyDisplaySize, error.get(), &raw, "(uu)");
     io::BusMessage size(raw);
     if (r >= 0)
         r = sd_bus_message_read(size.get(), "(uu)", &display.widthPx, &display.heightPx);
     if (r >= 0) {
         raw = nullptr;
-        r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "DisplaySizeMm",
-                                error.get(), &raw, "(dd)");
+        r = sd_bus_get_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                bus::kPropertyDisplaySizeMm, error.get(), &raw, "(dd)");
         size.reset(raw);
     }
     if (r >= 0)
@@ -144,7 +144,7 @@ std::variant<DaemonClient::Display, Failure> DaemonClient::display() {
 std::optional<Failure> DaemonClient::setTouchHeightMm(double heightMm) {
     io::UniqueBusError error;
     const int r = sd_bus_set_property(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                      "TouchHeightMm", error.get(), "d", heightMm);
+                                      bus::kPropertyTouchHeightMm, error.get(), "d", heightMm);
     if (r < 0)
         return explain(error, r, "Setting the touch height");
     return std::nullopt;
@@ -152,8 +152,8 @@ std::optional<Failure> DaemonClient::setTouchHeightMm(double heightMm) {
 
 std::optional<Failure> DaemonClient::snapshot(const std::string& what, int fd) {
     io::UniqueBusError error;
-    const int r = sd_bus_call_method(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "Snapshot",
-                                     error.get(), nullptr, "sh", what.c_str(), fd);
+    const int r = sd_bus_call_method(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                     bus::kMethodSnapshot, error.get(), nullptr, "sh", what.c_str(), fd);
     if (r < 0)
         return explain(error, r, "Taking a snapshot");
     return std::nullopt;
@@ -162,7 +162,7 @@ std::optional<Failure> DaemonClient::snapshot(const std::string& what, int fd) {
 std::optional<Failure> DaemonClient::saveCalibration() {
     io::UniqueBusError error;
     const int r = sd_bus_call_method(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                     "SaveCalibration", error.get(), nullptr, "");
+                                     bus::kMethodSaveCalibration, error.get(), nullptr, "");
     if (r < 0)
         return explain(error, r, "Saving the calibration");
     return std::nullopt;
@@ -223,11 +223,11 @@ std::variant<DaemonClient::CalibrationResult, Failure> DaemonClient::calibrate(
     sd_bus_slot* raw = nullptr;
     // Subscribe before calling, so that no signal of this job can slip past.
     int r = sd_bus_match_signal(bus_.get(), &raw, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                "CalibrationProgress", onProgressSignal, &follower);
+                                bus::kSignalCalibrationProgress, onProgressSignal, &follower);
     const io::BusSlot progressSlot(raw);
     if (r >= 0)
         r = sd_bus_match_signal(bus_.get(), &raw, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                "CalibrationFinished", onFinishedSignal, &follower);
+                                bus::kSignalCalibrationFinished, onFinishedSignal, &follower);
     const io::BusSlot finishedSlot(r >= 0 ? raw : nullptr);
     if (r >= 0)
         r = sd_bus_add_match(bus_.get(), &raw, kDaemonOwnerChanged, onOwnerChanged, &follower);
@@ -238,22 +238,24 @@ std::variant<DaemonClient::CalibrationResult, Failure> DaemonClient::calibrate(
 
     sd_bus_message* call = nullptr;
     r = sd_bus_message_new_method_call(bus_.get(), &call, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                       "Calibrate");
+                                       bus::kMethodCalibrate);
     const io::BusMessage message(call);
     if (r >= 0)
         r = sd_bus_message_append(message.get(), "s", step.c_str());
     if (r >= 0)
         r = sd_bus_message_open_container(message.get(), 'a', "{sv}");
     if (r >= 0 && options.frames)
-        r = sd_bus_message_append(message.get(), "{sv}", "frames", "u", *options.frames);
+        r = sd_bus_message_append(message.get(), "{sv}", bus::kOptionFrames, "u", *options.frames);
     if (r >= 0 && options.cardWidthMm)
-        r = sd_bus_message_append(message.get(), "{sv}", "card_width_mm", "d", *options.cardWidthMm);
+        r = sd_bus_message_append(message.get(), "{sv}", bus::kOptionCardWidthMm, "d", *options.cardWidthMm);
     if (r >= 0 && options.cardHeightMm)
-        r = sd_bus_message_append(message.get(), "{sv}", "card_height_mm", "d", *options.cardHeightMm);
+        r = sd_bus_message_append(message.get(), "{sv}", bus::kOptionCardHeightMm, "d",
+                                  *options.cardHeightMm);
     if (r >= 0 && options.views)
-        r = sd_bus_message_append(message.get(), "{sv}", "views", "u", *options.views);
+        r = sd_bus_message_append(message.get(), "{sv}", bus::kOptionViews, "u", *options.views);
     if (r >= 0 && options.viewTimeoutS)
-        r = sd_bus_message_append(message.get(), "{sv}", "view_timeout_s", "d", *options.viewTimeoutS);
+        r = sd_bus_message_append(message.get(), "{sv}", bus::kOptionViewTimeoutS, "d",
+                                  *options.viewTimeoutS);
     if (r >= 0)
         r = sd_bus_message_close_container(message.get());
     io::UniqueBusError error;
@@ -362,7 +364,7 @@ int onFrameRateTimer(sd_event_source* source, std::uint64_t, void* userdata) noe
         sd_bus_slot* raw = nullptr;
         if (sd_bus_call_method_async(follower->bus, &raw, bus::kBusName, bus::kObjectPath,
                                      kPropertiesInterface, "Get", onFrameRateReply, follower, "ss",
-                                     bus::kInterface, "FrameRate") >= 0) {
+                                     bus::kInterface, bus::kPropertyFrameRate) >= 0) {
             follower->frameRateCall.reset(raw);
             follower->frameRateCallPending = true;
         }
@@ -413,7 +415,7 @@ std::optional<Failure> DaemonClient::followContacts(const ContactsOptions& optio
     // Subscribe first, then read the frame rate: that reply also shows that the daemon is still there.
     sd_bus_slot* rawSlot = nullptr;
     int r = sd_bus_match_signal(bus_.get(), &rawSlot, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                                "Contacts", onContactsSignal, &follower);
+                                bus::kSignalContacts, onContactsSignal, &follower);
     const io::BusSlot contactsSlot(r >= 0 ? rawSlot : nullptr);
     if (r >= 0)
         r = sd_bus_add_match(bus_.get(), &rawSlot, kDaemonOwnerChanged, onDaemonOwnerChanged, &follower);
@@ -421,8 +423,8 @@ std::optional<Failure> DaemonClient::followContacts(const ContactsOptions& optio
     if (r < 0)
         return cannotFollow(r);
     io::UniqueBusError error;
-    r = sd_bus_get_property_trivial(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface, "FrameRate",
-                                    error.get(), 'd', &follower.frameRate);
+    r = sd_bus_get_property_trivial(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                    bus::kPropertyFrameRate, error.get(), 'd', &follower.frameRate);
     if (r < 0)
         return explain(error, r, "Reading the frame rate");
 

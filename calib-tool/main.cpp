@@ -23,6 +23,7 @@
 #include "contacts_view.h"
 #include "daemon_client.h"
 #include "io/handles.h"
+#include "service/bus_names.h"
 #include "tap_scoring.h"
 #include "text_format.h"
 #include "version.h"
@@ -41,13 +42,13 @@ int report(const Failure& failure) {
 // One line per property, in words.
 std::string describe(const std::string& name, const calib::PropertyValue& value) {
     if (const auto* text = std::get_if<std::string>(&value))
-        return text->empty() && name == "DevicePath" ? "(none)" : *text;
+        return text->empty() && name == bus::kPropertyDevicePath ? "(none)" : *text;
     if (const auto* flag = std::get_if<bool>(&value))
         return *flag ? "yes" : "no";
     if (const auto* number = std::get_if<double>(&value)) {
-        if (name == "FrameRate")
+        if (name == bus::kPropertyFrameRate)
             return calib::format("%.1f frames/s", *number);
-        if (name == "LatencyMs")
+        if (name == bus::kPropertyLatencyMs)
             return calib::format("%.1f ms", *number);
         return calib::format("%.1f mm", *number);
     }
@@ -65,10 +66,10 @@ int status() {
         return report(*failure);
     const auto& values = std::get<0>(properties);
     const std::pair<const char*, const char*> rows[] = {
-        {"State", "State"},           {"Rig", "Rig"},
-        {"Calibrated", "Calibrated"}, {"TouchHeightMm", "Touch height"},
-        {"FrameRate", "Frame rate"},  {"LatencyMs", "Latency"},
-        {"DroppedFrames", "Dropped"}, {"DevicePath", "Touch device"},
+        {bus::kPropertyState, "State"},           {bus::kPropertyRig, "Rig"},
+        {bus::kPropertyCalibrated, "Calibrated"}, {bus::kPropertyTouchHeightMm, "Touch height"},
+        {bus::kPropertyFrameRate, "Frame rate"},  {bus::kPropertyLatencyMs, "Latency"},
+        {bus::kPropertyDroppedFrames, "Dropped"}, {bus::kPropertyDevicePath, "Touch device"},
     };
     for (const auto& [property, label] : rows)
         if (const auto it = values.find(property); it != values.end())
@@ -92,7 +93,7 @@ int sensitivity(const std::optional<double>& heightMm) {
     if (auto* failure = std::get_if<Failure>(&properties))
         return report(*failure);
     const auto& values = std::get<0>(properties);
-    if (const auto it = values.find("TouchHeightMm"); it != values.end())
+    if (const auto it = values.find(bus::kPropertyTouchHeightMm); it != values.end())
         std::printf("%g\n", std::get<double>(it->second));
     return calib::kExitOk;
 }
@@ -196,10 +197,11 @@ int accuracyTest(double timeoutS, const std::optional<std::filesystem::path>& js
     auto properties = daemon.allProperties();
     if (auto* failure = std::get_if<Failure>(&properties))
         return report(*failure);
-    const std::string rig = textProperty(std::get<0>(properties), "Rig");
+    const std::string rig = textProperty(std::get<0>(properties), bus::kPropertyRig);
     if (const std::optional<std::string> problem = calib::accuracyTestRigProblem(rig))
         return report({calib::kExitFailure, *problem + "."});
-    if (const std::string state = textProperty(std::get<0>(properties), "State"); state != "running")
+    if (const std::string state = textProperty(std::get<0>(properties), bus::kPropertyState);
+        state != "running")
         return report({calib::kExitFailure, "everytouchd is not detecting touches (it is " + state +
                                                 "); \"everytouch-calib status\" shows why."});
     auto display = daemon.display();

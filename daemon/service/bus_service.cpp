@@ -55,15 +55,15 @@ CalibrationOptions readCalibrationOptions(sd_bus_message* message) {
     while ((r = sd_bus_message_enter_container(message, 'e', "sv")) > 0) {
         const char* key = nullptr;
         check(sd_bus_message_read(message, "s", &key), "Calibrate options");
-        if (std::strcmp(key, "frames") == 0)
+        if (std::strcmp(key, bus::kOptionFrames) == 0)
             options.pairsPerStep = readOption<std::uint32_t>(message, key, "u");
-        else if (std::strcmp(key, "card_width_mm") == 0)
+        else if (std::strcmp(key, bus::kOptionCardWidthMm) == 0)
             options.cardWidthMm = readOption<double>(message, key, "d");
-        else if (std::strcmp(key, "card_height_mm") == 0)
+        else if (std::strcmp(key, bus::kOptionCardHeightMm) == 0)
             options.cardHeightMm = readOption<double>(message, key, "d");
-        else if (std::strcmp(key, "views") == 0)
+        else if (std::strcmp(key, bus::kOptionViews) == 0)
             options.views = readOption<std::uint32_t>(message, key, "u");
-        else if (std::strcmp(key, "view_timeout_s") == 0)
+        else if (std::strcmp(key, bus::kOptionViewTimeoutS) == 0)
             options.viewTimeoutS = readOption<double>(message, key, "d");
         else
             throw BusError(SD_BUS_ERROR_INVALID_ARGS,
@@ -145,7 +145,7 @@ int setTouchHeightMm(sd_bus* bus, const char*, const char*, const char*, sd_bus_
         BusService& service = serviceOf(userdata);
         service.requirePrivileged(sd_bus_get_current_message(bus), "Setting TouchHeightMm");
         double heightMm = 0.0;
-        check(sd_bus_message_read(value, "d", &heightMm), "TouchHeightMm");
+        check(sd_bus_message_read(value, "d", &heightMm), bus::kPropertyTouchHeightMm);
         service.daemon().setTouchHeightMm(heightMm);
         return 0;
     });
@@ -210,32 +210,34 @@ int methodSnapshot(sd_bus_message* message, void* userdata, sd_bus_error* error)
 
 const sd_bus_vtable kVtable[] = {
     SD_BUS_VTABLE_START(0),
-    SD_BUS_PROPERTY("APIVersion", "u", getApiVersion, 0, SD_BUS_VTABLE_PROPERTY_CONST),
-    SD_BUS_PROPERTY("State", "s", getState, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
-    SD_BUS_PROPERTY("Rig", "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
-    SD_BUS_PROPERTY("Calibrated", "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_PROPERTY(bus::kPropertyApiVersion, "u", getApiVersion, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY(bus::kPropertyState, "s", getState, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_PROPERTY(bus::kPropertyRig, "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY(bus::kPropertyCalibrated, "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     // Statistics change with every frame: clients poll them instead of being flooded with signals.
-    SD_BUS_PROPERTY("DisplaySize", "(uu)", getDisplaySize, 0, 0),
-    SD_BUS_PROPERTY("DisplaySizeMm", "(dd)", getDisplaySizeMm, 0, 0),
-    SD_BUS_PROPERTY("FrameRate", "d", getFrameRate, 0, 0),
-    SD_BUS_PROPERTY("LatencyMs", "d", getLatencyMs, 0, 0),
-    SD_BUS_PROPERTY("DroppedFrames", "t", getDroppedFrames, 0, 0),
-    SD_BUS_WRITABLE_PROPERTY("TouchHeightMm", "d", getTouchHeightMm, setTouchHeightMm, 0,
+    SD_BUS_PROPERTY(bus::kPropertyDisplaySize, "(uu)", getDisplaySize, 0, 0),
+    SD_BUS_PROPERTY(bus::kPropertyDisplaySizeMm, "(dd)", getDisplaySizeMm, 0, 0),
+    SD_BUS_PROPERTY(bus::kPropertyFrameRate, "d", getFrameRate, 0, 0),
+    SD_BUS_PROPERTY(bus::kPropertyLatencyMs, "d", getLatencyMs, 0, 0),
+    SD_BUS_PROPERTY(bus::kPropertyDroppedFrames, "t", getDroppedFrames, 0, 0),
+    SD_BUS_WRITABLE_PROPERTY(bus::kPropertyTouchHeightMm, "d", getTouchHeightMm, setTouchHeightMm, 0,
                              SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE | SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_PROPERTY("DevicePath", "s", getDevicePath, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
-    SD_BUS_METHOD_WITH_ARGS("Calibrate", SD_BUS_ARGS("s", step, "a{sv}", options), SD_BUS_NO_RESULT,
+    SD_BUS_PROPERTY(bus::kPropertyDevicePath, "s", getDevicePath, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodCalibrate, SD_BUS_ARGS("s", step, "a{sv}", options), SD_BUS_NO_RESULT,
                             methodCalibrate, SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_METHOD_WITH_ARGS("SaveCalibration", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodSaveCalibration,
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodSaveCalibration, SD_BUS_NO_ARGS, SD_BUS_NO_RESULT,
+                            methodSaveCalibration, SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodResetCalibration, SD_BUS_NO_ARGS, SD_BUS_NO_RESULT,
+                            methodResetCalibration, SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodReloadConfig, SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodReloadConfig,
                             SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_METHOD_WITH_ARGS("ResetCalibration", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodResetCalibration,
-                            SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_METHOD_WITH_ARGS("ReloadConfig", SD_BUS_NO_ARGS, SD_BUS_NO_RESULT, methodReloadConfig,
-                            SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_METHOD_WITH_ARGS("Snapshot", SD_BUS_ARGS("s", what, "h", fd), SD_BUS_NO_RESULT, methodSnapshot,
-                            SD_BUS_VTABLE_UNPRIVILEGED),
-    SD_BUS_SIGNAL_WITH_ARGS("Contacts", SD_BUS_ARGS("a(uddbd)", contacts), 0),
-    SD_BUS_SIGNAL_WITH_ARGS("CalibrationProgress", SD_BUS_ARGS("s", step, "d", fraction, "s", message), 0),
-    SD_BUS_SIGNAL_WITH_ARGS("CalibrationFinished", SD_BUS_ARGS("b", ok, "s", message, "d", rms_px), 0),
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodSnapshot, SD_BUS_ARGS("s", what, "h", fd), SD_BUS_NO_RESULT,
+                            methodSnapshot, SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalContacts, SD_BUS_ARGS("a(uddbd)", contacts), 0),
+    SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalCalibrationProgress,
+                            SD_BUS_ARGS("s", step, "d", fraction, "s", message), 0),
+    SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalCalibrationFinished, SD_BUS_ARGS("b", ok, "s", message, "d", rms_px),
+                            0),
     SD_BUS_VTABLE_END,
 };
 
@@ -298,7 +300,8 @@ void BusService::propertiesChanged(const std::vector<const char*>& names) {
 
 void BusService::contacts(const core::Contacts& contacts) {
     sd_bus_message* raw = nullptr;
-    int r = sd_bus_message_new_signal(bus_.get(), &raw, bus::kObjectPath, bus::kInterface, "Contacts");
+    int r =
+        sd_bus_message_new_signal(bus_.get(), &raw, bus::kObjectPath, bus::kInterface, bus::kSignalContacts);
     const io::BusMessage signal(raw);
     if (r >= 0)
         r = sd_bus_message_open_container(signal.get(), 'a', "(uddbd)");
@@ -315,15 +318,17 @@ void BusService::contacts(const core::Contacts& contacts) {
 }
 
 void BusService::calibrationProgress(const std::string& step, double fraction, const std::string& message) {
-    const int r = sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, "CalibrationProgress",
-                                     "sds", step.c_str(), fraction, message.c_str());
+    const int r =
+        sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, bus::kSignalCalibrationProgress,
+                           "sds", step.c_str(), fraction, message.c_str());
     if (r < 0)
         ET_LOG(Warning) << "cannot send CalibrationProgress: " << std::strerror(-r);
 }
 
 void BusService::calibrationFinished(bool ok, const std::string& message, double rmsPx) {
-    const int r = sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, "CalibrationFinished",
-                                     "bsd", static_cast<int>(ok), message.c_str(), rmsPx);
+    const int r =
+        sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, bus::kSignalCalibrationFinished,
+                           "bsd", static_cast<int>(ok), message.c_str(), rmsPx);
     if (r < 0)
         ET_LOG(Warning) << "cannot send CalibrationFinished: " << std::strerror(-r);
 }

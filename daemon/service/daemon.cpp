@@ -181,7 +181,7 @@ std::vector<io::TouchSink*> Daemon::openOutputs() {
             inbox_.post([this, devnode] {
                 devicePath_ = devnode;
                 if (bus_)
-                    bus_->propertiesChanged({"DevicePath"});
+                    bus_->propertiesChanged({bus::kPropertyDevicePath});
             });
         });
         if (store_->active())
@@ -307,11 +307,11 @@ void Daemon::refreshState() {
     std::vector<const char*> changed;
     if (const DaemonState now = state(); now != reportedState_) {
         reportedState_ = now;
-        changed.push_back("State");
+        changed.push_back(bus::kPropertyState);
     }
     if (const bool now = calibrated(); now != reportedCalibrated_) {
         reportedCalibrated_ = now;
-        changed.push_back("Calibrated");
+        changed.push_back(bus::kPropertyCalibrated);
     }
     if (changed.empty())
         return;
@@ -396,7 +396,7 @@ void Daemon::setTouchHeightMm(double heightMm) {
     touchHeightMm_ = heightMm;
     applySettings();
     if (bus_)
-        bus_->propertiesChanged({"TouchHeightMm"});
+        bus_->propertiesChanged({bus::kPropertyTouchHeightMm});
     ET_LOG(Info) << "touch height set to " << heightMm << " mm";
 }
 
