@@ -1,11 +1,5 @@
 #include "service/snapshot.h"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <unistd.h>
-
-#include <cerrno>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -73,37 +67,6 @@ std::vector<unsigned char> encodePng(const cv::Mat& image) {
     std::vector<unsigned char> bytes;
     cv::imencode(".png", image, bytes);
     return bytes;
-}
-
-int writeAllWithin(int fd, const std::vector<unsigned char>& bytes, std::chrono::milliseconds timeout) {
-    const int flags = ::fcntl(fd, F_GETFL);
-    if (flags < 0)
-        return -errno;
-    if ((flags & O_ACCMODE) == O_RDONLY)
-        return -EBADF;
-    if (!(flags & O_NONBLOCK) && ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0)
-        return -errno;
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    size_t written = 0;
-    while (written < bytes.size()) {
-        const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-        if (n >= 0) {
-            written += static_cast<size_t>(n);
-            continue;
-        }
-        if (errno == EINTR)
-            continue;
-        if (errno != EAGAIN)
-            return -errno;
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-            deadline - std::chrono::steady_clock::now());
-        if (left.count() <= 0)
-            return -ETIMEDOUT;
-        pollfd waiting{fd, POLLOUT, 0};
-        if (::poll(&waiting, 1, static_cast<int>(left.count())) < 0 && errno != EINTR)
-            return -errno;
-    }
-    return 0;
 }
 
 }  // namespace everytouch::service

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <chrono>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -36,10 +35,5 @@ void renderSnapshot(SnapshotKind kind, const core::FramePair& pair, const core::
 
 // PNG bytes of an 8-bit image.
 std::vector<unsigned char> encodePng(const cv::Mat& image);
-
-// Writes all of `bytes` to `fd`, a descriptor someone else passed us: waits at most `timeout` for it to
-// accept them, so a reader that never reads cannot stall the caller. Returns 0 or a negative errno
-// (-EBADF when the descriptor is not open for writing, -ETIMEDOUT).
-int writeAllWithin(int fd, const std::vector<unsigned char>& bytes, std::chrono::milliseconds timeout);
 
 }  // namespace everytouch::service

@@ -24,17 +24,16 @@ void SnapshotRequests::add(SnapshotKind kind, int fd, SnapshotReply reply) {
         throw BusError(SD_BUS_ERROR_INVALID_ARGS, "The file descriptor is not open for writing");
     if (loop_.finished())
         throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
-    io::UniqueFd copy(::fcntl(fd, F_DUPFD_CLOEXEC, 3));
-    if (!copy)
-        throw BusError(SD_BUS_ERROR_FAILED,
-                       std::string("Cannot keep the file descriptor: ") + std::strerror(errno));
-
     const std::uint64_t id = nextId_++;
     Request& request = requests_[id];
+    if (const int r = request.writer.adopt(fd); r < 0) {
+        requests_.erase(id);
+        throw BusError(SD_BUS_ERROR_FAILED,
+                       std::string("Cannot keep the file descriptor: ") + std::strerror(-r));
+    }
     request.owner = this;
     request.id = id;
     request.reply = std::move(reply);
-    request.fd = std::move(copy);
     request.kind = kind;
     sd_event_source* timeout = nullptr;
     const auto timeoutUsec = std::chrono::duration_cast<std::chrono::microseconds>(timeouts_.frame).count();
@@ -63,13 +62,28 @@ void SnapshotRequests::complete(std::uint64_t id, const TappedPair& tapped) {
     const auto it = requests_.find(id);
     if (it == requests_.end())
         return;
+    Request& request = it->second;
     cv::Mat image;
-    render_(it->second.kind, tapped, image);
-    const int r = writeAllWithin(it->second.fd.get(), encodePng(image), timeouts_.write);
-    if (r < 0) {
+    render_(request.kind, tapped, image);
+    request.writing = true;
+    const auto writeUsec = std::chrono::duration_cast<std::chrono::microseconds>(timeouts_.write).count();
+    int r = sd_event_source_set_time_relative(request.timeout.get(), static_cast<std::uint64_t>(writeUsec));
+    if (r >= 0)
+        r = sd_event_source_set_enabled(request.timeout.get(), SD_EVENT_ONESHOT);
+    if (r >= 0)
+        r = request.writer.start(event_, encodePng(image), [this, id](int result) { written(id, result); });
+    if (r < 0)
         fail(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-r));
+}
+
+void SnapshotRequests::written(std::uint64_t id, int result) {
+    if (result < 0) {
+        fail(id, SD_BUS_ERROR_IO_ERROR, std::string("Cannot write the PNG: ") + std::strerror(-result));
         return;
     }
+    const auto it = requests_.find(id);
+    if (it == requests_.end())
+        return;
     const SnapshotReply reply = std::move(it->second.reply);
     requests_.erase(it);
     reply.done();
@@ -88,10 +102,17 @@ void SnapshotRequests::fail(std::uint64_t id, const char* errorName, const std::
 int SnapshotRequests::onTimeout(sd_event_source*, uint64_t, void* userdata) noexcept {
     auto* request = static_cast<Request*>(userdata);
     try {
+        const SnapshotTimeouts& timeouts = request->owner->timeouts_;
         std::ostringstream message;
-        message << "No camera frame pair arrived within "
-                << std::chrono::duration<double>(request->owner->timeouts_.frame).count() << " s";
-        request->owner->fail(request->id, bus::kErrorNoCamera, message.str());
+        if (request->writing) {
+            message << "The reader did not take the PNG within "
+                    << std::chrono::duration<double>(timeouts.write).count() << " s";
+            request->owner->fail(request->id, SD_BUS_ERROR_IO_ERROR, message.str());
+        } else {
+            message << "No camera frame pair arrived within "
+                    << std::chrono::duration<double>(timeouts.frame).count() << " s";
+            request->owner->fail(request->id, bus::kErrorNoCamera, message.str());
+        }
     } catch (const std::exception& error) {
         ET_LOG(Error) << "internal error: " << error.what();
     }

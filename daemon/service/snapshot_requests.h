@@ -12,6 +12,7 @@
 
 #include "core/frame.h"
 #include "io/handles.h"
+#include "service/descriptor_writer.h"
 #include "service/frame_loop.h"
 #include "service/main_loop_inbox.h"
 #include "service/snapshot.h"
@@ -31,14 +32,15 @@ struct SnapshotReply {
 struct SnapshotTimeouts {
     // A request fails with NoCamera when no frame pair arrives within this time.
     std::chrono::milliseconds frame{3000};
-    // How long the receiving end of a descriptor may take to accept the PNG, so that a client that never
-    // reads cannot stall the main thread.
+    // How long the receiving end of a descriptor may take to accept the PNG; it is written while the main
+    // loop goes on, and a client that never reads gets an error after this time.
     std::chrono::milliseconds write{3000};
 };
 
-// The Snapshot calls waiting for a frame pair: each keeps its own copy of the caller's descriptor and a
-// timeout, asks the frame loop's tap for the next pair, and once it arrives has it rendered, writes it to the
-// descriptor as a PNG and answers the call. Main thread only.
+// The Snapshot calls waiting for a frame pair: each keeps its own descriptor for the caller's and a timeout,
+// asks the frame loop's tap for the next pair, and once it arrives has it rendered, writes it to the
+// descriptor as a PNG without blocking the main loop (DescriptorWriter) and answers the call. Main thread
+// only.
 class SnapshotRequests {
 public:
     // `event` runs the timeouts; `inbox` brings the pairs from the pipeline thread to the main thread. All
@@ -61,13 +63,15 @@ private:
         SnapshotRequests* owner = nullptr;
         std::uint64_t id = 0;
         SnapshotReply reply;
-        io::UniqueFd fd;
+        DescriptorWriter writer;
+        bool writing = false;  // the pair came; the timeout is now the write's
         SnapshotKind kind = SnapshotKind::Camera;
         FrameTap::Ticket ticket = 0;
         io::EventSource timeout;
     };
 
     void complete(std::uint64_t id, const TappedPair& tapped);
+    void written(std::uint64_t id, int result);
     void fail(std::uint64_t id, const char* errorName, const std::string& message);
     static int onTimeout(sd_event_source* source, uint64_t usec, void* userdata) noexcept;
 

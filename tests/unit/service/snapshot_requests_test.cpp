@@ -3,11 +3,13 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <functional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -202,6 +204,75 @@ TEST_F(SnapshotRequestsTest, AReaderThatWentAwayGetsAnIoError) {
     EXPECT_EQ(answers.failures.front().first, SD_BUS_ERROR_IO_ERROR);
     EXPECT_THAT(answers.failures.front().second, HasSubstr("Cannot write the PNG: Broken pipe"));
     EXPECT_EQ(requests.pending(), 0u);
+}
+
+// Draws noise, whose PNG is larger than a pipe holds.
+SnapshotRenderer noiseRenderer() {
+    return [](SnapshotKind, const TappedPair& tapped, cv::Mat& image) {
+        image.create(tapped.pair.latest().image.size() * 4, CV_8UC1);
+        cv::randu(image, 0, 256);
+    };
+}
+
+TEST_F(SnapshotRequestsTest, AReaderThatNeverReadsHoldsUpNothingButItsOwnCall) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
+    SnapshotRequests requests(event_.get(), loop, inbox_, noiseRenderer(), SnapshotTimeouts{3000ms, 300ms});
+    int ends[2];
+    ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
+    const io::UniqueFd readEnd(ends[0]);
+    const io::UniqueFd writeEnd(ends[1]);
+    Answers answers;
+    requests.add(SnapshotKind::Camera, writeEnd.get(), answers.reply());
+
+    loop.start();
+    // Every turn of the main loop stays short while the PNG waits for its reader.
+    Clock::duration longestTurn{};
+    const auto deadline = Clock::now() + 30s;
+    while (answers.done + answers.failures.size() == 0 && Clock::now() < deadline) {
+        const auto begun = Clock::now();
+        ASSERT_GE(sd_event_run(event_.get(), 20'000), 0);
+        longestTurn = std::max(longestTurn, Clock::now() - begun);
+    }
+    EXPECT_LT(longestTurn, 150ms);
+    EXPECT_EQ(answers.done, 0);
+    ASSERT_EQ(answers.failures.size(), 1u);
+    EXPECT_EQ(answers.failures.front().first, SD_BUS_ERROR_IO_ERROR);
+    EXPECT_EQ(answers.failures.front().second, "The reader did not take the PNG within 0.3 s");
+    EXPECT_EQ(requests.pending(), 0u);
+}
+
+TEST_F(SnapshotRequestsTest, ASlowReaderGetsTheWholePngAndItsDescriptorKeepsItsFlags) {
+    io::ReplaySource source(dir_ / "recording", false);
+    FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
+    SnapshotRequests requests(event_.get(), loop, inbox_, noiseRenderer());
+    int ends[2];
+    ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
+    io::UniqueFd readEnd(ends[0]);
+    io::UniqueFd writeEnd(ends[1]);
+    const int flagsBefore = ::fcntl(writeEnd.get(), F_GETFL);
+    Answers answers;
+    requests.add(SnapshotKind::Camera, writeEnd.get(), answers.reply());
+    std::vector<unsigned char> received;
+    std::thread reader([&] {
+        unsigned char chunk[4096];
+        for (ssize_t n; (n = ::read(readEnd.get(), chunk, sizeof chunk)) > 0;) {
+            received.insert(received.end(), chunk, chunk + n);
+            std::this_thread::sleep_for(1ms);
+        }
+    });
+
+    loop.start();
+    const bool answered = runUntil([&] { return answers.done + answers.failures.size() > 0; }, 30s);
+    EXPECT_EQ(::fcntl(writeEnd.get(), F_GETFL), flagsBefore);
+    writeEnd.reset();
+    requests.failAll(bus::kErrorNoCamera, "the test ends");  // closes the daemon's own descriptor too
+    reader.join();
+    ASSERT_TRUE(answered);
+    EXPECT_EQ(answers.done, 1);
+    EXPECT_TRUE(answers.failures.empty());
+    const cv::Mat image = cv::imdecode(received, cv::IMREAD_UNCHANGED);
+    EXPECT_EQ(image.size(), test::smallRig().calibration.cameraSize * 4);
 }
 
 TEST_F(SnapshotRequestsTest, FailAllAnswersEveryPendingRequest) {

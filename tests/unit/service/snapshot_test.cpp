@@ -167,29 +167,5 @@ TEST(Snapshot, OverlaySaysWhenThereIsNoCalibration) {
     EXPECT_GT(cv::norm(overlay, plain, cv::NORM_L1), 0.0) << "nothing written on the image";
 }
 
-TEST(Snapshot, PngGoesThroughAPipe) {
-    const cv::Mat image = test::codedImages({40, 30}, 10).positive;
-    const std::vector<unsigned char> png = encodePng(image);
-    int ends[2];
-    ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
-    ASSERT_EQ(writeAllWithin(ends[1], png, 1000ms), 0);
-    ::close(ends[1]);
-    std::vector<unsigned char> received(png.size() + 1);
-    ASSERT_EQ(::read(ends[0], received.data(), received.size()), static_cast<ssize_t>(png.size()));
-    ::close(ends[0]);
-    received.resize(png.size());
-    EXPECT_EQ(cv::norm(cv::imdecode(received, cv::IMREAD_UNCHANGED), image, cv::NORM_INF), 0.0);
-}
-
-TEST(Snapshot, AReaderThatNeverReadsTimesOutInsteadOfBlocking) {
-    const std::vector<unsigned char> big(1 << 20, 7);  // more than a pipe holds
-    int ends[2];
-    ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
-    EXPECT_EQ(writeAllWithin(ends[1], big, 100ms), -ETIMEDOUT);
-    EXPECT_EQ(writeAllWithin(ends[0], big, 100ms), -EBADF);
-    ::close(ends[0]);
-    ::close(ends[1]);
-}
-
 }  // namespace
 }  // namespace everytouch::service
