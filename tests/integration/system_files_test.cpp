@@ -28,8 +28,8 @@ TEST(SystemFiles, TheUnitVerifies) {
 
 TEST(SystemFiles, TheUnitStaysHardened) {
     const test::ProcessResult result = test::runProcess(
-        {"/usr/bin/systemd-analyze", "security", "--offline=true", "--threshold=30", BUILD_UNIT_FILE});
-    EXPECT_EQ(result.exitCode, 0) << "exposure above 3.0:\n" << result.out;
+        {"/usr/bin/systemd-analyze", "security", "--offline=true", "--threshold=20", BUILD_UNIT_FILE});
+    EXPECT_EQ(result.exitCode, 0) << "exposure above 2.0:\n" << result.out;
     EXPECT_THAT(test::fileContents(BUILD_UNIT_FILE), HasSubstr("Type=notify"));
     EXPECT_THAT(test::fileContents(BUILD_UNIT_FILE), HasSubstr("ExecStart=" EVERYTOUCHD_PATH " --service"));
 }
