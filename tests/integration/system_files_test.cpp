@@ -115,7 +115,7 @@ std::set<std::string> commentedKeys(const std::string& example) {
 
 TEST(SystemFiles, TheExampleConfigurationAndTheManualDocumentEveryKey) {
     const std::string example = test::fileContents(EXAMPLE_CONFIG);
-    const std::string manual = test::fileContents(DAEMON_MANUAL);
+    const std::string manual = test::fileContents(CONFIG_MANUAL);
     std::set<std::string> known;
     for (const auto& [section, key] : service::configKeys()) {
         known.insert("[" + section + "] " + key);
