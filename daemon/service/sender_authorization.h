@@ -10,8 +10,9 @@
 namespace everytouch::service {
 
 // Decides whether the sender of a method call may change the daemon's state: root, or a member of the
-// privileged group, judged by the effective uid and the groups the bus reports for the sender. This holds on
-// top of the D-Bus policy, which already keeps others from calling; it guards against a looser policy.
+// privileged group, judged by the effective uid the bus reports for the sender and by the groups the bus
+// reports or, where it reports none, the group database. This holds on top of the D-Bus policy, which already
+// keeps others from calling; it guards against a looser policy.
 class SenderAuthorization {
 public:
     // Looks the group up now; without such a group only root is allowed.

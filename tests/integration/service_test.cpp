@@ -51,7 +51,7 @@
 namespace everytouch {
 
 // The "everytouch" group for the tests of group members (see main()).
-std::optional<gid_t> privilegedGroup;
+std::optional<test::GroupMember> privilegedGroupMember;
 std::string privilegedGroupProblem;
 
 namespace {
@@ -66,6 +66,13 @@ constexpr auto kExitTimeout = 30s;
 
 const std::vector<std::string> kNobody = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
                                           "--clear-groups"};
+
+// Runs a command as a user the group database lists in the "everytouch" group, with the groups a login
+// would give it.
+std::vector<std::string> asGroupMember() {
+    return {"/usr/bin/setpriv", "--reuid=" + std::to_string(privilegedGroupMember->uid), "--regid=65534",
+            "--init-groups"};
+}
 
 std::vector<std::string> concat(std::vector<std::string> first, const std::vector<std::string>& second) {
     first.insert(first.end(), second.begin(), second.end());
@@ -921,11 +928,10 @@ TEST_F(ServiceTest, ARigWithoutACalibrationFileCannotSave) {
 }
 
 TEST_F(ServiceTest, MembersOfTheEverytouchGroupMayChangeState) {
-    if (!privilegedGroup)
-        GTEST_SKIP() << "cannot provide the \"everytouch\" group: " << privilegedGroupProblem;
+    if (!privilegedGroupMember)
+        GTEST_SKIP() << "cannot provide a member of the \"everytouch\" group: " << privilegedGroupProblem;
     startDaemon();
-    const std::vector<std::string> member = {"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
-                                             "--groups=" + std::to_string(*privilegedGroup)};
+    const std::vector<std::string> member = asGroupMember();
     test::ProcessResult result =
         test::runProcess(concat(member, {EVERYTOUCH_CALIB_PATH, "sensitivity", "6"}));
     EXPECT_EQ(result.exitCode, 0) << result.err;
@@ -1336,13 +1342,11 @@ TEST_F(DaemonOwnChecksTest, CallersNeitherRootNorInTheGroupAreRefused) {
 }
 
 TEST_F(DaemonOwnChecksTest, GroupMembersAreLetIn) {
-    if (!privilegedGroup)
-        GTEST_SKIP() << "cannot provide the \"everytouch\" group: " << privilegedGroupProblem;
+    if (!privilegedGroupMember)
+        GTEST_SKIP() << "cannot provide a member of the \"everytouch\" group: " << privilegedGroupProblem;
     startDaemon();
-    const test::ProcessResult result =
-        test::runProcess(concat({"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
-                                 "--groups=" + std::to_string(*privilegedGroup)},
-                                concat(property("set-property", "TouchHeightMm"), {"d", "8"})));
+    const test::ProcessResult result = test::runProcess(
+        concat(asGroupMember(), concat(property("set-property", "TouchHeightMm"), {"d", "8"})));
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("TouchHeightMm"), "d 8\n");
 }
@@ -1391,8 +1395,8 @@ TEST(EverytouchdService, WithoutACameraSaysSoAndExits) {
 
 int main(int argc, char** argv) {
     using namespace everytouch;
-    // First, while this process has a single thread (see provideGroup).
-    privilegedGroup = test::provideGroup(bus::kPrivilegedGroup, privilegedGroupProblem);
+    // First, while this process has a single thread (see provideGroupMember).
+    privilegedGroupMember = test::provideGroupMember(bus::kPrivilegedGroup, privilegedGroupProblem);
     ::testing::InitGoogleTest(&argc, argv);
     return RUN_ALL_TESTS();
 }

@@ -1,6 +1,7 @@
 #include "support/test_group.h"
 
 #include <grp.h>
+#include <pwd.h>
 #include <sched.h>
 #include <sys/mount.h>
 #include <sys/stat.h>
@@ -15,17 +16,32 @@ namespace everytouch::test {
 
 namespace {
 
-std::optional<gid_t> lookUp(const std::string& name) {
-    if (const group* entry = ::getgrnam(name.c_str()))
-        return entry->gr_gid;
-    return std::nullopt;
+constexpr const char* kMemberName = "everytouch-test-member";
+constexpr gid_t kNogroup = 65534;
+
+// Lays a file with this text over `target` in the current mount namespace.
+bool layOver(const char* target, const std::string& text, std::string& why) {
+    char path[] = "/tmp/everytouch-test-db-XXXXXX";
+    const int fd = ::mkstemp(path);
+    if (fd < 0) {
+        why = std::string("cannot write a copy of ") + target + ": " + std::strerror(errno);
+        return false;
+    }
+    const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+    ::fchmod(fd, 0644);
+    ::close(fd);
+    const bool mounted = written && ::mount(path, target, nullptr, MS_BIND, nullptr) == 0;
+    const int mountError = errno;
+    // The mount keeps the file's contents; its name is no longer needed.
+    ::unlink(path);
+    if (!mounted)
+        why = std::string("cannot lay a copy over ") + target + ": " + std::strerror(mountError);
+    return mounted;
 }
 
 }  // namespace
 
-std::optional<gid_t> provideGroup(const std::string& name, std::string& why) {
-    if (const std::optional<gid_t> existing = lookUp(name))
-        return existing;
+std::optional<GroupMember> provideGroupMember(const std::string& groupName, std::string& why) {
     if (::unshare(CLONE_NEWNS) < 0) {
         why = std::string("cannot enter a private mount namespace: ") + std::strerror(errno);
         return std::nullopt;
@@ -34,29 +50,35 @@ std::optional<gid_t> provideGroup(const std::string& name, std::string& why) {
         why = std::string("cannot make the mounts private: ") + std::strerror(errno);
         return std::nullopt;
     }
-    gid_t gid = 60999;
-    while (gid > 60000 && ::getgrgid(gid))
-        --gid;
+    GroupMember member{kMemberName, 60999, 60999};
+    while (member.uid > 60000 && ::getpwuid(member.uid))
+        --member.uid;
+    if (const group* existing = ::getgrnam(groupName.c_str())) {
+        member.gid = existing->gr_gid;
+    } else {
+        while (member.gid > 60000 && ::getgrgid(member.gid))
+            --member.gid;
+    }
+
+    std::ostringstream users;
+    users << std::ifstream("/etc/passwd").rdbuf() << kMemberName << ":x:" << member.uid << ":" << kNogroup
+          << "::/nonexistent:/usr/sbin/nologin\n";
+    // The group's line, if any, is replaced by one that also lists the member.
     std::ostringstream groups;
-    groups << std::ifstream("/etc/group").rdbuf() << name << ":x:" << gid << ":\n";
-    char path[] = "/tmp/everytouch-test-group-XXXXXX";
-    const int fd = ::mkstemp(path);
-    if (fd < 0) {
-        why = std::string("cannot write a group file: ") + std::strerror(errno);
-        return std::nullopt;
+    std::ifstream groupFile("/etc/group");
+    std::string members;
+    for (std::string line; std::getline(groupFile, line);) {
+        if (line.rfind(groupName + ":", 0) == 0) {
+            members = line.substr(line.rfind(':') + 1);
+            continue;
+        }
+        groups << line << '\n';
     }
-    const std::string text = groups.str();
-    const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
-    ::fchmod(fd, 0644);
-    ::close(fd);
-    const bool mounted = written && ::mount(path, "/etc/group", nullptr, MS_BIND, nullptr) == 0;
-    // The mount keeps the file's contents; its name is no longer needed.
-    ::unlink(path);
-    if (!mounted) {
-        why = std::string("cannot lay the group file over /etc/group: ") + std::strerror(errno);
+    groups << groupName << ":x:" << member.gid << ":" << members << (members.empty() ? "" : ",")
+           << kMemberName << '\n';
+    if (!layOver("/etc/passwd", users.str(), why) || !layOver("/etc/group", groups.str(), why))
         return std::nullopt;
-    }
-    return lookUp(name);
+    return member;
 }
 
 }  // namespace everytouch::test

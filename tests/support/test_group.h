@@ -7,10 +7,18 @@
 
 namespace everytouch::test {
 
-// Makes sure a group of this name exists for this process and its children, so that tests can run a client
-// as a member of it. If the system has none, and this process may, it enters a private mount namespace and
-// lays a copy of /etc/group with the group added over the real one; the host is not touched. Must run
-// before any thread starts (first thing in main). Returns the group id, or nothing with the reason in `why`.
-std::optional<gid_t> provideGroup(const std::string& name, std::string& why);
+// A user the group database lists as a member of a group.
+struct GroupMember {
+    std::string userName;
+    uid_t uid = 0;
+    gid_t gid = 0;  // the group's
+};
+
+// Makes sure, for this process and its children, that a group of this name exists and that a user of its own
+// is listed as a member, so that tests can run a client as that user. It enters a private mount namespace
+// and lays copies of /etc/passwd and /etc/group with the user and the membership added over the real ones;
+// the host is not touched. Must run before any thread starts (first thing in main). Returns the member, or
+// nothing with the reason in `why`.
+std::optional<GroupMember> provideGroupMember(const std::string& groupName, std::string& why);
 
 }  // namespace everytouch::test
