@@ -12,7 +12,7 @@ packages=(
     build-essential cmake pkg-config clang-format
     libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
     libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools
-    libcli11-dev nlohmann-json3-dev libinih-dev scdoc lintian
+    libcli11-dev nlohmann-json3-dev libinih-dev scdoc mandoc lintian
     dbus systemd udev
     qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils
 )

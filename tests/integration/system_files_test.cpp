@@ -1,4 +1,5 @@
 // The files that install everytouchd as a service: the unit, the example configuration, the manual page.
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -111,6 +112,21 @@ std::set<std::string> commentedKeys(const std::string& example) {
             keys.insert("[" + section + "] " + std::string(match[1]));
     }
     return keys;
+}
+
+TEST(SystemFiles, TheManualPagesHaveNoMandocWarning) {
+    int pages = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(BUILD_DIR) + "/man")) {
+        if (!std::regex_match(entry.path().filename().string(), std::regex(".+\\.[158]")))
+            continue;
+        ++pages;
+        // Style remarks (long source lines, a lower-case title) are scdoc's and change nothing on the page.
+        const test::ProcessResult result =
+            test::runProcess({"/usr/bin/mandoc", "-T", "lint", "-W", "warning", entry.path().string()});
+        EXPECT_EQ(result.exitCode, 0) << entry.path();
+        EXPECT_EQ(result.out + result.err, "") << entry.path();
+    }
+    EXPECT_EQ(pages, 3);
 }
 
 TEST(SystemFiles, TheExampleConfigurationAndTheManualDocumentEveryKey) {
