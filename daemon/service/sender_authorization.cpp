@@ -12,15 +12,14 @@ namespace everytouch::service {
 
 namespace {
 
-// Whether the group database makes this user a member of the group, as its primary group or in its list.
+// Whether the group database makes this user a member of the group, as its primary group or in its list
+// (getgrouplist returns both).
 bool databaseListsMember(uid_t uid, gid_t gid) {
     std::vector<char> buffer(16384);
     passwd entry{};
     passwd* found = nullptr;
     if (getpwuid_r(uid, &entry, buffer.data(), buffer.size(), &found) != 0 || !found)
         return false;
-    if (found->pw_gid == gid)
-        return true;
     std::vector<gid_t> groups(64);
     int count = static_cast<int>(groups.size());
     while (getgrouplist(found->pw_name, found->pw_gid, groups.data(), &count) < 0) {

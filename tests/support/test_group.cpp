@@ -50,7 +50,7 @@ std::optional<GroupMember> provideGroupMember(const std::string& groupName, std:
         why = std::string("cannot make the mounts private: ") + std::strerror(errno);
         return std::nullopt;
     }
-    GroupMember member{kMemberName, 60999, 60999};
+    GroupMember member{60999, 60999};
     while (member.uid > 60000 && ::getpwuid(member.uid))
         --member.uid;
     if (const group* existing = ::getgrnam(groupName.c_str())) {

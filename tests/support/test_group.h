@@ -9,7 +9,6 @@ namespace everytouch::test {
 
 // A user the group database lists as a member of a group.
 struct GroupMember {
-    std::string userName;
     uid_t uid = 0;
     gid_t gid = 0;  // the group's
 };
