@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,6 +26,10 @@ public:
     virtual std::optional<RigDescription> rig() const = 0;
 
     virtual std::string describe() const = 0;
+
+    // Frames the source lost before they reached `next` (a camera's incomplete or skipped frames); safe to
+    // call from any thread.
+    virtual std::uint64_t droppedFrames() const { return 0; }
 
     // Ground truth of the frame `next` returned last, when the source knows it (the simulator): one entry per
     // finger the scene presents over the display, possibly none. Nothing for sources without ground truth.

@@ -43,18 +43,29 @@ std::optional<bool> parseBoolean(const std::string& text) {
     return std::nullopt;
 }
 
-double parseMillimetres(const std::string& text, double minimum, double maximum) {
+// A number from `minimum` to `maximum`, of `unit` (its name in words for "expected a number of", its symbol
+// for the range).
+double parseQuantity(const std::string& text, double minimum, double maximum, const std::string& unitWords,
+                     const std::string& unitSymbol) {
     double value = 0.0;
     const char* end = text.data() + text.size();
     const auto [stop, error] = std::from_chars(text.data(), end, value);
     if (error != std::errc() || stop != end || !std::isfinite(value))
-        throw BadValue{"expected a number of millimetres, found \"" + text + "\""};
+        throw BadValue{"expected a number of " + unitWords + ", found \"" + text + "\""};
     if (value < minimum || value > maximum) {
         char range[64];
         std::snprintf(range, sizeof range, "%g to %g", minimum, maximum);
-        throw BadValue{"must be from " + std::string(range) + " mm, found " + text};
+        throw BadValue{"must be from " + std::string(range) + " " + unitSymbol + ", found " + text};
     }
     return value;
+}
+
+// An optional camera setting: empty leaves it to the camera.
+std::optional<double> parseCameraQuantity(const std::string& text, double minimum, double maximum,
+                                          const std::string& unitWords, const std::string& unitSymbol) {
+    if (text.empty())
+        return std::nullopt;
+    return parseQuantity(text, minimum, maximum, unitWords, unitSymbol);
 }
 
 const std::vector<KeySpec>& keySpecs() {
@@ -74,11 +85,34 @@ const std::vector<KeySpec>& keySpecs() {
              }
              config.rig = value;
          }},
+        {"Camera", "PixelFormat",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.pixels.reset();
+             if (value.empty())
+                 return;
+             config.camera.pixels = io::parseCameraPixels(value);
+             if (!config.camera.pixels)
+                 throw BadValue{"expected one of " + io::cameraPixelsNames() + ", found \"" + value + "\""};
+         }},
+        {"Camera", "FrameRate",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.frameRate =
+                 parseCameraQuantity(value, kMinFrameRate, kMaxFrameRate, "frames per second", "frames/s");
+         }},
+        {"Camera", "ExposureUs",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.exposureUs =
+                 parseCameraQuantity(value, kMinExposureUs, kMaxExposureUs, "microseconds", "us");
+         }},
+        {"Camera", "GainDb",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.gainDb = parseCameraQuantity(value, kMinGainDb, kMaxGainDb, "decibels", "dB");
+         }},
         {"Touch", "HeightMm",
          [](DaemonConfig& config, const std::string& value) {
-             config.touchHeightMm = value.empty()
-                                        ? DaemonConfig().touchHeightMm
-                                        : parseMillimetres(value, kMinTouchHeightMm, kMaxTouchHeightMm);
+             config.touchHeightMm = value.empty() ? DaemonConfig().touchHeightMm
+                                                  : parseQuantity(value, kMinTouchHeightMm, kMaxTouchHeightMm,
+                                                                  "millimetres", "mm");
          }},
         {"Output", "Uinput",
          [](DaemonConfig& config, const std::string& value) {

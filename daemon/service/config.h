@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/camera_settings.h"
+
 namespace everytouch::service {
 
 // The range of TouchHeightMm: a finger whose pad is at most this high above the table touches it. Above 30 mm
@@ -13,10 +15,20 @@ namespace everytouch::service {
 inline constexpr double kMinTouchHeightMm = 0.0;
 inline constexpr double kMaxTouchHeightMm = 30.0;
 
+// The ranges of the camera keys: beyond them no camera of a touch table works (a pair of frames must come
+// faster than a tap, an exposure must fit a frame, a gain beyond 60 dB is noise).
+inline constexpr double kMinFrameRate = 1.0;
+inline constexpr double kMaxFrameRate = 1000.0;
+inline constexpr double kMinExposureUs = 1.0;
+inline constexpr double kMaxExposureUs = 1'000'000.0;
+inline constexpr double kMinGainDb = 0.0;
+inline constexpr double kMaxGainDb = 60.0;
+
 // The daemon's configuration file, everytouchd.conf (documented key by key in everytouchd(8) and in the
 // shipped example). Command-line options override it.
 struct DaemonConfig {
     std::string rig;                        // [Camera] Rig=: a --rig spec; empty when no camera is configured
+    io::CameraSettings camera;              // [Camera] PixelFormat=, FrameRate=, ExposureUs=, GainDb=
     double touchHeightMm = 3.0;             // [Touch] HeightMm=: touching at or below this height, mm
     std::optional<bool> uinput;             // [Output] Uinput=: virtual touchscreen; unset: only for cameras
     std::filesystem::path calibrationPath;  // [Calibration] Path=: calibration store; empty: not configured

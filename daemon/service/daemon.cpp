@@ -86,7 +86,7 @@ int Daemon::run() {
     const io::RigSpec spec = io::RigSpec::parse(rigText);
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
-    OpenedRig opened = openRig(spec, options_.fast);
+    OpenedRig opened = openRig(spec, options_.fast, config_.camera);
     source_ = std::move(opened.source);
     projector_ = std::move(opened.projector);
     recordedRig_ = spec.kind == io::RigSpec::Kind::Replay;

@@ -97,7 +97,7 @@ LoopStatistics FrameLoop::statistics() const {
         statistics.pipelineMedianMs = at(0.5);
         statistics.pipelineP99Ms = at(0.99);
     }
-    statistics.dropped = queue_.dropped();
+    statistics.dropped = queue_.dropped() + source_.droppedFrames();
     statistics.frameRate = arrivals_.perSecond(Clock::now());
     if (!finished_)
         statistics.seconds = std::chrono::duration<double>(Clock::now() - started_).count();

@@ -26,7 +26,7 @@ namespace everytouch::service {
 struct LoopStatistics {
     std::uint64_t frames = 0;   // camera frames taken from the source
     std::uint64_t pairs = 0;    // frame pairs formed
-    std::uint64_t dropped = 0;  // frames dropped because the pipeline fell behind the camera
+    std::uint64_t dropped = 0;  // frames the source lost, and frames dropped because the pipeline fell behind
     double frameRate = 0.0;     // camera frames per second over the last second
     double latencyMs = 0.0;  // from a frame's arrival to its contacts reaching the sinks, smoothed over ~1 s
     double seconds = 0.0;    // wall-clock time since start, or of the whole run once finished

@@ -1,5 +1,6 @@
 #include "service/frame_sources.h"
 
+#include "io/aravis_source.h"
 #include "io/input_error.h"
 #include "io/replay_source.h"
 #include "io/sim_projector.h"
@@ -7,7 +8,7 @@
 
 namespace everytouch::service {
 
-OpenedRig openRig(const io::RigSpec& spec, bool fast) {
+OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera) {
     OpenedRig rig;
     switch (spec.kind) {
         case io::RigSpec::Kind::Replay:
@@ -20,9 +21,11 @@ OpenedRig openRig(const io::RigSpec& spec, bool fast) {
             return rig;
         }
         case io::RigSpec::Kind::Aravis:
+            rig.source = std::make_unique<io::AravisSource>("--rig " + spec.toString(), spec.target, camera);
+            return rig;
         case io::RigSpec::Kind::V4l2:
             throw io::InputError("--rig " + spec.toString(), "",
-                                 "camera rigs are not part of this build yet");
+                                 "V4L2 cameras are not part of this build yet");
     }
     throw io::InputError("--rig " + spec.toString(), "", "unknown rig kind");
 }

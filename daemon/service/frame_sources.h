@@ -2,6 +2,7 @@
 
 #include <memory>
 
+#include "io/camera_settings.h"
 #include "io/frame_source.h"
 #include "io/projector_output.h"
 #include "io/rig_spec.h"
@@ -15,7 +16,7 @@ struct OpenedRig {
     std::unique_ptr<io::ProjectorOutput> projector;  // none for a recording, which shows what it shows
 };
 
-// Opens the rig a --rig spec names. Throws InputError when the spec cannot be served.
-OpenedRig openRig(const io::RigSpec& spec, bool fast);
+// Opens the rig a --rig spec names; a camera gets `camera`. Throws InputError when the spec cannot be served.
+OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera);
 
 }  // namespace everytouch::service

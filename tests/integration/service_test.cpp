@@ -38,6 +38,7 @@
 #include "service/table_set_up_step.h"
 #include "sim/rig_geometry.h"
 #include "sim/sim_parameters.h"
+#include "support/bus_commands.h"
 #include "support/coded_recording.h"
 #include "support/file_contents.h"
 #include "support/notify_socket.h"
@@ -74,22 +75,10 @@ std::vector<std::string> asGroupMember() {
             "--init-groups"};
 }
 
-std::vector<std::string> concat(std::vector<std::string> first, const std::vector<std::string>& second) {
-    first.insert(first.end(), second.begin(), second.end());
-    return first;
-}
-
-std::vector<std::string> busctl(const std::vector<std::string>& arguments) {
-    return concat({"/usr/bin/busctl", "--system", "--no-pager"}, arguments);
-}
-
-std::vector<std::string> property(const std::string& verb, const std::string& name) {
-    return busctl({verb, bus::kBusName, bus::kObjectPath, bus::kInterface, name});
-}
-
-std::vector<std::string> call(const std::string& method, const std::vector<std::string>& arguments = {}) {
-    return concat(busctl({"call", bus::kBusName, bus::kObjectPath, bus::kInterface, method}), arguments);
-}
+using test::busctl;
+using test::call;
+using test::concat;
+using test::property;
 
 // A recording long enough for any test (a minute at 10 frames/s), shared by the tests of one process.
 class SharedRecording {

@@ -41,9 +41,11 @@ TEST(Config, ReadsEveryKey) {
     test::TempDir dir;
     write(dir / "everytouchd.conf",
           "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
-          "[Calibration]\nPath=/var/lib/et/cal.yml\n");
+          "[Calibration]\nPath=/var/lib/et/cal.yml\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
+          "ExposureUs=4000\nGainDb=6\n");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
     EXPECT_EQ(config.rig, "replay:/srv/rec");
+    EXPECT_EQ(config.camera, (io::CameraSettings{io::CameraPixels::BayerGr8, 119.5, 4000.0, 6.0}));
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
@@ -51,13 +53,14 @@ TEST(Config, ReadsEveryKey) {
 
 TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
     test::TempDir dir;
-    write(dir / "everytouchd.conf", "[Touch]\nHeightMm=5\n[Camera]\nRig=aravis\n");
+    write(dir / "everytouchd.conf", "[Touch]\nHeightMm=5\n[Camera]\nRig=aravis\nFrameRate=60\n");
     write(dir / "everytouchd.conf.d" / "20-late.conf", "[Touch]\nHeightMm=9\n");
-    write(dir / "everytouchd.conf.d" / "10-early.conf", "[Touch]\nHeightMm=1\n[Camera]\nRig=\n");
+    write(dir / "everytouchd.conf.d" / "10-early.conf", "[Touch]\nHeightMm=1\n[Camera]\nRig=\nFrameRate=\n");
     write(dir / "everytouchd.conf.d" / "ignored.txt", "this is not a config file");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 9.0);
     EXPECT_EQ(config.rig, "");
+    EXPECT_EQ(config.camera.frameRate, std::nullopt);
 }
 
 TEST(Config, UnknownKeyNamesFileLineAndKey) {
@@ -92,6 +95,13 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
         {"[Output]\nUinput=maybe\n", ":2: [Output] Uinput: expected yes or no, found \"maybe\""},
         {"[Calibration]\nPath=calibration.yml\n", ":2: [Calibration] Path: expected an absolute path"},
         {"[Camera]\nRig=webcam\n", ":2: [Camera] Rig: expected sim[:SCENARIO]"},
+        {"[Camera]\nPixelFormat=YUV422\n",
+         ":2: [Camera] PixelFormat: expected one of Mono8, RGB8, BGR8, BayerRG8, BayerBG8, BayerGR8, "
+         "BayerGB8, "
+         "found \"YUV422\""},
+        {"[Camera]\nFrameRate=0.5\n", ":2: [Camera] FrameRate: must be from 1 to 1000 frames/s, found 0.5"},
+        {"[Camera]\nExposureUs=fast\n", ":2: [Camera] ExposureUs: expected a number of microseconds"},
+        {"[Camera]\nGainDb=-3\n", ":2: [Camera] GainDb: must be from 0 to 60 dB, found -3"},
     };
     for (const auto& [text, expected] : cases) {
         write(dir / "everytouchd.conf", text);

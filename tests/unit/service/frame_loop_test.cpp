@@ -1,6 +1,7 @@
 #include "service/frame_loop.h"
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
@@ -104,6 +105,28 @@ private:
     int count_ = 0;
 };
 
+// A camera that loses every third frame on its way, as a loaded GigE link can, and counts what it lost.
+class LossySource final : public io::FrameSource {
+public:
+    explicit LossySource(const std::filesystem::path& recording) : recording_(recording, false) {}
+
+    std::optional<core::Frame> next() override {
+        while (std::optional<core::Frame> frame = recording_.next()) {
+            if (frame->index % 3 != 2)
+                return frame;
+            ++lost_;
+        }
+        return std::nullopt;
+    }
+    std::optional<io::RigDescription> rig() const override { return recording_.rig(); }
+    std::string describe() const override { return "a lossy " + recording_.describe(); }
+    std::uint64_t droppedFrames() const override { return lost_.load(); }
+
+private:
+    io::ReplaySource recording_;
+    std::atomic<std::uint64_t> lost_{0};
+};
+
 class FrameLoopTest : public ::testing::Test {
 protected:
     void SetUp() override { test::writeCodedRecording(dir_ / "recording", test::smallRig(), 20, 8333); }
@@ -157,6 +180,19 @@ TEST_F(FrameLoopTest, ASlowPipelineDropsTheOldestFramesAndCountsThem) {
     EXPECT_EQ(statistics.frames, 20u);
     EXPECT_GT(statistics.dropped, 0u);
     EXPECT_LT(statistics.pairs, 19u);
+}
+
+TEST_F(FrameLoopTest, FramesTheSourceLostCountAsDropped) {
+    LossySource source(dir_ / "recording");
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    loop.start();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    const LoopStatistics statistics = loop.statistics();
+    EXPECT_EQ(statistics.frames, 14u);  // of 20
+    EXPECT_EQ(statistics.dropped, 6u);
 }
 
 TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {

@@ -1,0 +1,209 @@
+#include "io/aravis_source.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include "io/input_error.h"
+
+namespace everytouch::io {
+
+namespace {
+
+constexpr int kStreamBuffers = 8;
+// The camera's frame counter: GigE Vision's wraps after 65535 and skips 0.
+constexpr std::uint64_t kGvFrameIdLimit = 0xFFFF;
+// A jump of the counter larger than this is the camera starting over, not frames lost.
+constexpr std::uint64_t kMostMissed = 1000;
+
+std::string messageOf(const GErrorHandle& error) {
+    return error && error->message ? error->message : "unknown error";
+}
+
+// Throws InputError for `field` when `error` was set.
+void check(GErrorHandle& error, const std::string& input, const std::string& field, const std::string& what) {
+    if (error)
+        throw InputError(input, field, what + ": " + messageOf(error));
+}
+
+std::vector<std::string> offeredPixels(ArvCamera* camera) {
+    std::vector<std::string> offered;
+    guint count = 0;
+    GError* error = nullptr;
+    const char** names = arv_camera_dup_available_pixel_formats_as_strings(camera, &count, &error);
+    GErrorHandle owned(error);
+    for (guint i = 0; names && i < count; ++i)
+        offered.emplace_back(names[i]);
+    g_free(names);
+    return offered;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& name : names)
+        text += (text.empty() ? "" : ", ") + name;
+    return text.empty() ? "none" : text;
+}
+
+}  // namespace
+
+std::uint64_t framesMissedBetween(std::uint64_t last, std::uint64_t next) {
+    std::uint64_t step = 0;
+    if (last <= kGvFrameIdLimit && next <= kGvFrameIdLimit)
+        step = (next + kGvFrameIdLimit - last % kGvFrameIdLimit) % kGvFrameIdLimit;
+    else if (next > last)
+        step = next - last;
+    return step >= 1 && step <= kMostMissed ? step - 1 : 0;
+}
+
+AravisSource::AravisSource(const std::string& input, const std::string& id, const CameraSettings& settings) {
+    GError* raw = nullptr;
+    if (id.empty()) {
+        arv_update_device_list();
+        if (arv_get_n_devices() == 0)
+            throw std::runtime_error(
+                input + ": no GenICam camera found (arv-tool-0.8 lists the cameras Aravis sees)");
+    }
+    camera_.reset(arv_camera_new(id.empty() ? nullptr : id.c_str(), &raw));
+    GErrorHandle error(raw);
+    if (!camera_)
+        throw std::runtime_error(input + ": no camera answers" +
+                                 (id.empty() ? std::string() : " as \"" + id + "\"") + ": " +
+                                 messageOf(error) + " (arv-tool-0.8 lists the cameras Aravis sees)");
+
+    ArvCamera* camera = camera_.get();
+    const std::vector<std::string> offered = offeredPixels(camera);
+    const std::optional<CameraPixels> pixels =
+        settings.pixels ? settings.pixels : preferredCameraPixels(offered);
+    if (!pixels)
+        throw InputError(input, "",
+                         "the camera offers no pixel format everytouchd reads (it offers " + joined(offered) +
+                             "; everytouchd reads " + cameraPixelsNames() + ")");
+    if (std::find(offered.begin(), offered.end(), cameraPixelsName(*pixels)) == offered.end())
+        throw InputError(
+            input, "[Camera] PixelFormat",
+            std::string(cameraPixelsName(*pixels)) + " is not offered; the camera offers " + joined(offered));
+    pixels_ = *pixels;
+    arv_camera_set_pixel_format_from_string(camera, std::string(cameraPixelsName(pixels_)).c_str(), &raw);
+    error.reset(raw);
+    check(error, input, "[Camera] PixelFormat", "the camera refused it");
+
+    if (settings.frameRate) {
+        arv_camera_set_frame_rate(camera, *settings.frameRate, &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] FrameRate", "the camera refused it");
+    }
+    if (settings.exposureUs) {
+        arv_camera_set_exposure_time(camera, *settings.exposureUs, &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] ExposureUs", "the camera refused it");
+    }
+    if (settings.gainDb) {
+        arv_camera_set_gain(camera, *settings.gainDb, &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] GainDb", "the camera refused it");
+    }
+    arv_camera_set_acquisition_mode(camera, ARV_ACQUISITION_MODE_CONTINUOUS, &raw);
+    error.reset(raw);
+    check(error, input, "", "the camera cannot run continuously");
+    if (arv_camera_is_gv_device(camera)) {
+        // The largest packet the link carries: fewer packets a frame, fewer lost.
+        arv_camera_gv_auto_packet_size(camera, &raw);
+        error.reset(raw);
+    }
+
+    gint x = 0, y = 0, width = 0, height = 0;
+    arv_camera_get_region(camera, &x, &y, &width, &height, &raw);
+    error.reset(raw);
+    check(error, input, "", "the camera does not tell its image size");
+    size_ = cv::Size(width, height);
+    frameRate_ = arv_camera_get_frame_rate(camera, &raw);
+    error.reset(raw);
+    if (error || !(frameRate_ > 0.0))
+        frameRate_ = 0.0;
+    const std::size_t payload = arv_camera_get_payload(camera, &raw);
+    error.reset(raw);
+    check(error, input, "", "the camera does not tell its frame size");
+    if (payload < cameraPixelsBytes(size_, pixels_))
+        throw InputError(input, "",
+                         "the camera's frames (" + std::to_string(payload) + " bytes) are smaller than " +
+                             std::to_string(width) + "x" + std::to_string(height) + " " +
+                             std::string(cameraPixelsName(pixels_)));
+
+    stream_.reset(arv_camera_create_stream(camera, nullptr, nullptr, &raw));
+    error.reset(raw);
+    if (!stream_)
+        throw std::runtime_error(input + ": no stream from the camera: " + messageOf(error));
+    for (int i = 0; i < kStreamBuffers; ++i)
+        arv_stream_push_buffer(stream_.get(), arv_buffer_new_allocate(payload));
+    arv_camera_start_acquisition(camera, &raw);
+    error.reset(raw);
+    if (error)
+        throw std::runtime_error(input + ": the camera does not start: " + messageOf(error));
+
+    const char* vendor = arv_camera_get_vendor_name(camera, nullptr);
+    const char* model = arv_camera_get_model_name(camera, nullptr);
+    const char* serial = arv_camera_get_device_serial_number(camera, nullptr);
+    char rate[32];
+    std::snprintf(rate, sizeof rate, "%.4g", frameRate_);
+    description_ = std::string("camera ") + (vendor ? vendor : "?") + " " + (model ? model : "?") +
+                   " (serial " + (serial ? serial : "?") + "), " + std::to_string(width) + "x" +
+                   std::to_string(height) + " " + std::string(cameraPixelsName(pixels_)) + " at " + rate +
+                   " frames/s";
+}
+
+AravisSource::~AravisSource() {
+    // A camera that stopped answering is not asked again: each command would wait for its timeouts.
+    if (camera_ && !stalled_)
+        arv_camera_stop_acquisition(camera_.get(), nullptr);
+}
+
+double AravisSource::stallTimeoutSeconds() const {
+    return frameRate_ > 0.0 ? std::max(0.5, 10.0 / frameRate_) : 1.0;
+}
+
+std::optional<core::Frame> AravisSource::next() {
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point giveUp = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                        std::chrono::duration<double>(stallTimeoutSeconds()));
+    while (Clock::now() < giveUp) {
+        // A short wait at a time, so that a stalled camera is noticed on time.
+        ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream_.get(), 100'000);
+        if (!buffer)
+            continue;
+        const std::uint64_t frameId = arv_buffer_get_frame_id(buffer);
+        std::size_t bytes = 0;
+        const void* data = arv_buffer_get_image_data(buffer, &bytes);
+        const cv::Size size(arv_buffer_get_image_width(buffer), arv_buffer_get_image_height(buffer));
+        const bool complete = arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS && data != nullptr &&
+                              size.width > 0 && size.height > 0 && bytes >= cameraPixelsBytes(size, pixels_);
+        // Frames lost on the way keep their places in the indices, so that the polarity stays with the count.
+        const std::uint64_t missed =
+            (lastFrameId_ ? framesMissedBetween(*lastFrameId_, frameId) : 0) + (complete ? 0 : 1);
+        dropped_ += missed;
+        nextIndex_ += missed;
+        lastFrameId_ = frameId;
+        if (!complete) {
+            arv_stream_push_buffer(stream_.get(), buffer);
+            continue;
+        }
+
+        core::Frame frame;
+        convertCameraPixels(static_cast<const std::uint8_t*>(data), size, pixels_, frame.image);
+        const guint64 cameraNs = arv_buffer_get_timestamp(buffer);
+        const guint64 hostNs = arv_buffer_get_system_timestamp(buffer);
+        arv_stream_push_buffer(stream_.get(), buffer);
+        frame.timestampUs = static_cast<std::int64_t>((cameraNs != 0 ? cameraNs : hostNs) / 1000);
+        frame.index = nextIndex_++;
+        frame.polarity = frame.index % 2 == 0 ? core::Polarity::Positive : core::Polarity::Negative;
+        return frame;
+    }
+    stalled_ = true;
+    char waited[32];
+    std::snprintf(waited, sizeof waited, "%.1f", stallTimeoutSeconds());
+    throw std::runtime_error(description_ + ": no complete frame for " + waited + " s");
+}
+
+}  // namespace everytouch::io

@@ -1,0 +1,19 @@
+#pragma once
+
+#include <optional>
+
+#include "io/camera_pixels.h"
+
+namespace everytouch::io {
+
+// What the configuration asks of a camera ([Camera] keys of everytouchd.conf); unset: the camera's own.
+struct CameraSettings {
+    std::optional<CameraPixels> pixels;  // PixelFormat=; unset: preferredCameraPixels of what it offers
+    std::optional<double> frameRate;     // FrameRate=, frames per second
+    std::optional<double> exposureUs;    // ExposureUs=, microseconds
+    std::optional<double> gainDb;        // GainDb=, decibels
+
+    bool operator==(const CameraSettings&) const = default;
+};
+
+}  // namespace everytouch::io

@@ -1,0 +1,140 @@
+// everytouchd on a GigE Vision camera: Aravis's fake camera served by this process on the loopback interface,
+// the daemon as a separate process on a private system bus, as a service would run it.
+#include <signal.h>
+
+#include <chrono>
+#include <deque>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "support/bus_commands.h"
+#include "support/fake_gige_camera.h"
+#include "support/notify_socket.h"
+#include "support/private_bus.h"
+#include "support/process.h"
+#include "support/temp_dir.h"
+
+namespace everytouch {
+namespace {
+
+using namespace std::chrono_literals;
+using ::testing::HasSubstr;
+
+// Generous for two busy cores; every wait ends as soon as its condition holds.
+constexpr auto kStartTimeout = 60s;
+constexpr auto kExitTimeout = 30s;
+
+class CameraServiceTest : public ::testing::Test {
+protected:
+    static constexpr int kRememberedFrames = 120;
+
+    CameraServiceTest()
+        : bus_(POLICY_FILE, false),
+          camera_(cv::Size(320, 240), [this](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+              // A ramp that moves by a level each frame: every frame differs from the last few hundred.
+              for (int y = 0; y < image.rows; ++y)
+                  for (int x = 0; x < image.cols; ++x)
+                      image.at<uchar>(y, x) = static_cast<uchar>((x + y + frameId) % 256);
+              std::lock_guard lock(mutex_);
+              sent_.push_back(image.clone());
+              if (sent_.size() > kRememberedFrames)
+                  sent_.pop_front();
+          }) {}
+
+    void TearDown() override {
+        if (daemon_ && HasFailure())
+            std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
+    }
+
+    // Starts everytouchd on the camera with `cameraKeys` in [Camera]; it has no virtual touchscreen here.
+    void startDaemon(const std::string& cameraKeys) {
+        std::ofstream(dir_ / "everytouchd.conf")
+            << "[Camera]\nRig=aravis:" << test::FakeGigeCamera::kAddress << "\n"
+            << cameraKeys
+            << "[Output]\nUinput=no\n[Calibration]\nPath=" << (dir_ / "calibration.yml").string() << "\n";
+        notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
+        daemon_ = std::make_unique<test::BackgroundProcess>(
+            std::vector<std::string>{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string()},
+            dir_ / "everytouchd.log",
+            std::vector<std::pair<std::string, std::string>>{{"NOTIFY_SOCKET", notify_->path().string()}});
+    }
+
+    std::string get(const std::string& name) {
+        return test::runProcess(test::property("get-property", name)).out;
+    }
+
+    bool sentRecently(const cv::Mat& image) {
+        std::lock_guard lock(mutex_);
+        for (const cv::Mat& sent : sent_)
+            if (sent.size() == image.size() && cv::norm(sent, image, cv::NORM_INF) == 0.0)
+                return true;
+        return false;
+    }
+
+    test::TempDir dir_;
+    test::PrivateBus bus_;
+    std::mutex mutex_;
+    std::deque<cv::Mat> sent_;
+    test::FakeGigeCamera camera_;
+    std::unique_ptr<test::NotifySocket> notify_;
+    std::unique_ptr<test::BackgroundProcess> daemon_;
+};
+
+TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
+    startDaemon("PixelFormat=Mono8\nFrameRate=30\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    EXPECT_EQ(get("Rig"), "s \"aravis:127.0.0.1\"\n");
+    double frameRate = 0.0;
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline && !(frameRate > 25.0 && frameRate < 35.0)) {
+        std::this_thread::sleep_for(100ms);
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &frameRate);
+    }
+    EXPECT_GT(frameRate, 25.0);
+    EXPECT_LT(frameRate, 35.0);
+    EXPECT_EQ(get("DroppedFrames"), "t 0\n");
+
+    // What the camera sees, as the camera sent it.
+    const std::filesystem::path file = dir_ / "camera.png";
+    const test::ProcessResult snapshot =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", file.string()});
+    ASSERT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(image.type(), CV_8UC1);
+    ASSERT_EQ(image.size(), cv::Size(320, 240));
+    EXPECT_TRUE(sentRecently(image)) << "the snapshot is no frame the camera sent lately";
+
+    const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
+    EXPECT_THAT(status.out, HasSubstr("State:         degraded"));
+    EXPECT_THAT(status.out, HasSubstr("Calibrated:    no"));
+
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+}
+
+TEST_F(CameraServiceTest, ACameraThatGoesAwayStopsTheDaemonWithAFailureForSystemdToRestartIt) {
+    startDaemon("PixelFormat=Mono8\nFrameRate=60\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    camera_.unplug();
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 1);
+    EXPECT_THAT(daemon_->output(), HasSubstr("no complete frame for 0.5 s"));
+}
+
+TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {
+    startDaemon("PixelFormat=BGR8\n");
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 2);
+    EXPECT_THAT(daemon_->output(),
+                HasSubstr("--rig aravis:127.0.0.1: [Camera] PixelFormat: BGR8 is not offered; the "
+                          "camera offers BayerBG8, BayerGB8, BayerGR8, BayerRG8, Mono8, RGB8, Mono16"));
+}
+
+}  // namespace
+}  // namespace everytouch
