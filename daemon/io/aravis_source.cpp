@@ -15,6 +15,8 @@ namespace {
 constexpr int kStreamBuffers = 8;
 // The camera's frame counter: GigE Vision's wraps after 65535 and skips 0.
 constexpr std::uint64_t kGvFrameIdLimit = 0xFFFF;
+// A triggered camera waits for its trigger: a projector that pauses is no lost camera yet.
+constexpr double kTriggeredStallSeconds = 2.0;
 // A jump of the counter larger than this is the camera starting over, not frames lost.
 constexpr std::uint64_t kMostMissed = 1000;
 
@@ -33,6 +35,18 @@ std::vector<std::string> offeredPixels(ArvCamera* camera) {
     guint count = 0;
     GError* error = nullptr;
     const char** names = arv_camera_dup_available_pixel_formats_as_strings(camera, &count, &error);
+    GErrorHandle owned(error);
+    for (guint i = 0; names && i < count; ++i)
+        offered.emplace_back(names[i]);
+    g_free(names);
+    return offered;
+}
+
+std::vector<std::string> offeredTriggerSources(ArvCamera* camera) {
+    std::vector<std::string> offered;
+    guint count = 0;
+    GError* error = nullptr;
+    const char** names = arv_camera_dup_available_trigger_sources(camera, &count, &error);
     GErrorHandle owned(error);
     for (guint i = 0; names && i < count; ++i)
         offered.emplace_back(names[i]);
@@ -90,6 +104,12 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
     error.reset(raw);
     check(error, input, "[Camera] PixelFormat", "the camera refused it");
 
+    if (settings.region) {
+        const cv::Rect& region = *settings.region;
+        arv_camera_set_region(camera, region.x, region.y, region.width, region.height, &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] Region", "the camera refused it");
+    }
     if (settings.frameRate) {
         arv_camera_set_frame_rate(camera, *settings.frameRate, &raw);
         error.reset(raw);
@@ -104,6 +124,22 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
         arv_camera_set_gain(camera, *settings.gainDb, &raw);
         error.reset(raw);
         check(error, input, "[Camera] GainDb", "the camera refused it");
+    }
+    // Last: setting the frame rate turns the frame trigger off on some cameras (Aravis does so for them).
+    if (settings.trigger == "off") {
+        arv_camera_clear_triggers(camera, &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] Trigger", "the camera cannot run free");
+    } else if (settings.trigger) {
+        const std::vector<std::string> sources = offeredTriggerSources(camera);
+        if (std::find(sources.begin(), sources.end(), *settings.trigger) == sources.end())
+            throw InputError(
+                input, "[Camera] Trigger",
+                "the camera has no trigger source " + *settings.trigger + "; it offers " + joined(sources));
+        arv_camera_set_trigger(camera, settings.trigger->c_str(), &raw);
+        error.reset(raw);
+        check(error, input, "[Camera] Trigger", "the camera refused it");
+        trigger_ = *settings.trigger;
     }
     arv_camera_set_acquisition_mode(camera, ARV_ACQUISITION_MODE_CONTINUOUS, &raw);
     error.reset(raw);
@@ -148,10 +184,11 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
     const char* serial = arv_camera_get_device_serial_number(camera, nullptr);
     char rate[32];
     std::snprintf(rate, sizeof rate, "%.4g", frameRate_);
-    description_ = std::string("camera ") + (vendor ? vendor : "?") + " " + (model ? model : "?") +
-                   " (serial " + (serial ? serial : "?") + "), " + std::to_string(width) + "x" +
-                   std::to_string(height) + " " + std::string(cameraPixelsName(pixels_)) + " at " + rate +
-                   " frames/s";
+    description_ =
+        std::string("camera ") + (vendor ? vendor : "?") + " " + (model ? model : "?") + " (serial " +
+        (serial ? serial : "?") + "), " + std::to_string(width) + "x" + std::to_string(height) + " " +
+        std::string(cameraPixelsName(pixels_)) +
+        (trigger_.empty() ? " at " + std::string(rate) + " frames/s" : ", triggered by " + trigger_);
 }
 
 AravisSource::~AravisSource() {
@@ -161,6 +198,8 @@ AravisSource::~AravisSource() {
 }
 
 double AravisSource::stallTimeoutSeconds() const {
+    if (!trigger_.empty())
+        return kTriggeredStallSeconds;
     return frameRate_ > 0.0 ? std::max(0.5, 10.0 / frameRate_) : 1.0;
 }
 
@@ -203,7 +242,9 @@ std::optional<core::Frame> AravisSource::next() {
     stalled_ = true;
     char waited[32];
     std::snprintf(waited, sizeof waited, "%.1f", stallTimeoutSeconds());
-    throw std::runtime_error(description_ + ": no complete frame for " + waited + " s");
+    throw std::runtime_error(
+        description_ + ": no complete frame for " + waited + " s" +
+        (trigger_.empty() ? std::string() : " (is the trigger on " + trigger_ + " running?)"));
 }
 
 }  // namespace everytouch::io

@@ -18,10 +18,11 @@ namespace everytouch::io {
 // 16-bit counter wraps from 65535 to 1; a counter that jumps back or by more than 1000 started over (0).
 std::uint64_t framesMissedBetween(std::uint64_t last, std::uint64_t next);
 
-// A GenICam camera through Aravis (GigE Vision, USB3 Vision), free running. Each frame is copied once out of
-// the stream's buffer, which goes straight back to the stream. Buffers the camera or the link did not
-// complete, and frames missing from the camera's frame counter, are counted as dropped and never delivered.
-// Frames carry the camera's timestamps and alternate in polarity by their place in the camera's count.
+// A GenICam camera through Aravis (GigE Vision, USB3 Vision), free running or on a trigger line. Each frame
+// is copied once out of the stream's buffer, which goes straight back to the stream. Buffers the camera or
+// the link did not complete, and frames missing from the camera's frame counter, are counted as dropped and
+// never delivered. Frames carry the camera's timestamps and alternate in polarity by their place in the
+// camera's count.
 class AravisSource final : public FrameSource {
 public:
     // `id` as arv-tool-0.8 lists it, or a GigE camera's address; empty: the first camera found. Throws
@@ -42,7 +43,7 @@ public:
 
     double frameRate() const { return frameRate_; }
     // How long next() waits for a frame before it gives up on the camera: ten frame periods, at least
-    // half a second.
+    // half a second; two seconds on a trigger.
     double stallTimeoutSeconds() const;
 
 private:
@@ -52,6 +53,7 @@ private:
     cv::Size size_;
     double frameRate_ = 0.0;
     std::string description_;
+    std::string trigger_;  // the trigger source frames wait for; empty when free running
     std::optional<std::uint64_t> lastFrameId_;
     std::uint64_t nextIndex_ = 0;
     bool stalled_ = false;  // next() gave up on the camera

@@ -1,6 +1,9 @@
 #pragma once
 
 #include <optional>
+#include <string>
+
+#include <opencv2/core/types.hpp>
 
 #include "io/camera_pixels.h"
 
@@ -12,6 +15,9 @@ struct CameraSettings {
     std::optional<double> frameRate;     // FrameRate=, frames per second
     std::optional<double> exposureUs;    // ExposureUs=, microseconds
     std::optional<double> gainDb;        // GainDb=, decibels
+    std::optional<cv::Rect> region;      // Region=WxH+X+Y, sensor pixels
+    // Trigger=: "off" to run free, or the trigger source (e.g. Line0) whose rising edge starts each frame.
+    std::optional<std::string> trigger;
 
     bool operator==(const CameraSettings&) const = default;
 };

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <regex>
 #include <vector>
 
 #include "io/handles.h"
@@ -107,6 +108,34 @@ const std::vector<KeySpec>& keySpecs() {
         {"Camera", "GainDb",
          [](DaemonConfig& config, const std::string& value) {
              config.camera.gainDb = parseCameraQuantity(value, kMinGainDb, kMaxGainDb, "decibels", "dB");
+         }},
+        {"Camera", "Region",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.region.reset();
+             if (value.empty())
+                 return;
+             static const std::regex geometry(R"((\d{1,5})x(\d{1,5})(?:\+(\d{1,5})\+(\d{1,5}))?)");
+             std::smatch match;
+             if (!std::regex_match(value, match, geometry))
+                 throw BadValue{"expected WIDTHxHEIGHT or WIDTHxHEIGHT+X+Y in pixels, found \"" + value +
+                                "\""};
+             const cv::Rect region(match[3].matched ? std::stoi(match[3]) : 0,
+                                   match[4].matched ? std::stoi(match[4]) : 0, std::stoi(match[1]),
+                                   std::stoi(match[2]));
+             if (region.width < kMinRegionSide || region.height < kMinRegionSide)
+                 throw BadValue{"must be at least " + std::to_string(kMinRegionSide) +
+                                " pixels wide and high, found " + value};
+             config.camera.region = region;
+         }},
+        {"Camera", "Trigger",
+         [](DaemonConfig& config, const std::string& value) {
+             config.camera.trigger.reset();
+             if (value.empty())
+                 return;
+             static const std::regex source(R"([A-Za-z][A-Za-z0-9_]{0,31})");
+             if (!std::regex_match(value, source))
+                 throw BadValue{"expected off or a trigger source such as Line0, found \"" + value + "\""};
+             config.camera.trigger = value;
          }},
         {"Touch", "HeightMm",
          [](DaemonConfig& config, const std::string& value) {

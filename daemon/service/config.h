@@ -23,14 +23,16 @@ inline constexpr double kMinExposureUs = 1.0;
 inline constexpr double kMaxExposureUs = 1'000'000.0;
 inline constexpr double kMinGainDb = 0.0;
 inline constexpr double kMaxGainDb = 60.0;
+// A camera region smaller than this cannot hold a display's worth of code.
+inline constexpr int kMinRegionSide = 64;
 
 // The daemon's configuration file, everytouchd.conf (documented key by key in everytouchd(8) and in the
 // shipped example). Command-line options override it.
 struct DaemonConfig {
-    std::string rig;                        // [Camera] Rig=: a --rig spec; empty when no camera is configured
-    io::CameraSettings camera;              // [Camera] PixelFormat=, FrameRate=, ExposureUs=, GainDb=
-    double touchHeightMm = 3.0;             // [Touch] HeightMm=: touching at or below this height, mm
-    std::optional<bool> uinput;             // [Output] Uinput=: virtual touchscreen; unset: only for cameras
+    std::string rig;             // [Camera] Rig=: a --rig spec; empty when no camera is configured
+    io::CameraSettings camera;   // [Camera] PixelFormat=, FrameRate=, ExposureUs=, GainDb=, Region=, Trigger=
+    double touchHeightMm = 3.0;  // [Touch] HeightMm=: touching at or below this height, mm
+    std::optional<bool> uinput;  // [Output] Uinput=: virtual touchscreen; unset: only for cameras
     std::filesystem::path calibrationPath;  // [Calibration] Path=: calibration store; empty: not configured
 
     bool operator==(const DaemonConfig&) const = default;

@@ -20,6 +20,11 @@ FakeGigeCamera::~FakeGigeCamera() {
     unplug();
 }
 
+void FakeGigeCamera::triggerSoftware() {
+    arv_fake_camera_write_register(arv_gv_fake_camera_get_fake_camera(camera_),
+                                   ARV_FAKE_CAMERA_REGISTER_TRIGGER_SOFTWARE, 1);
+}
+
 void FakeGigeCamera::unplug() {
     if (camera_)
         g_object_unref(camera_);

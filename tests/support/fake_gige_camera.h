@@ -27,6 +27,9 @@ public:
     FakeGigeCamera(const FakeGigeCamera&) = delete;
     FakeGigeCamera& operator=(const FakeGigeCamera&) = delete;
 
+    // A pulse on the camera's software trigger, as its TriggerSoftware command gives.
+    void triggerSoftware();
+
     // The camera goes away at once, as when its cable is pulled.
     void unplug();
 

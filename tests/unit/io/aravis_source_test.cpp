@@ -84,6 +84,18 @@ private:
     test::FakeGigeCamera camera_;  // last: it stops filling before the rest goes
 };
 
+CameraSettings withPixels(CameraPixels pixels) {
+    CameraSettings settings;
+    settings.pixels = pixels;
+    return settings;
+}
+
+CameraSettings mono8At(double frameRate) {
+    CameraSettings settings = withPixels(CameraPixels::Mono8);
+    settings.frameRate = frameRate;
+    return settings;
+}
+
 // What opening the camera throws: bad input (the configuration's fault) or a failure (which may pass).
 std::string errorOf(const std::string& id, const CameraSettings& settings) {
     try {
@@ -110,8 +122,7 @@ TEST(AravisSource, FramesMissingFromTheCamerasCountAreCountedAcrossItsWrap) {
 
 TEST(AravisSource, DeliversTheCamerasFramesUnchangedInOrderWithTheCamerasTime) {
     SimulatedGigeCamera camera;
-    AravisSource source("--rig aravis:127.0.0.1", "127.0.0.1",
-                        CameraSettings{CameraPixels::Mono8, 60.0, std::nullopt, std::nullopt});
+    AravisSource source("--rig aravis:127.0.0.1", "127.0.0.1", mono8At(60.0));
     EXPECT_THAT(source.describe(), HasSubstr("648x488 Mono8 at 60 frames/s"));
     std::vector<core::Frame> frames;
     for (int i = 0; i < 8; ++i) {
@@ -170,9 +181,7 @@ TEST(AravisSource, ReadsColourFromTheCamerasBayerMosaicByDefault) {
 
 TEST(AravisSource, ACameraThatGoesAwayEndsTheStreamWithAClearErrorOnTime) {
     SimulatedGigeCamera camera;
-    auto source =
-        std::make_unique<AravisSource>("--rig aravis:127.0.0.1", "127.0.0.1",
-                                       CameraSettings{CameraPixels::Mono8, 60.0, std::nullopt, std::nullopt});
+    auto source = std::make_unique<AravisSource>("--rig aravis:127.0.0.1", "127.0.0.1", mono8At(60.0));
     ASSERT_TRUE(source->next());
     camera.unplug();
     const auto start = std::chrono::steady_clock::now();
@@ -188,11 +197,34 @@ TEST(AravisSource, ACameraThatGoesAwayEndsTheStreamWithAClearErrorOnTime) {
     EXPECT_LT(seconds, source->stallTimeoutSeconds() + 0.5);
 }
 
+TEST(AravisSource, TakesItsRegionAndAFramePerPulseOnItsTrigger) {
+    test::FakeGigeCamera camera(cv::Size(648, 488),
+                                [](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+                                    image.setTo(cv::Scalar(static_cast<double>(frameId % 256)));
+                                });
+    CameraSettings triggered = mono8At(60.0);
+    triggered.region = cv::Rect(8, 4, 320, 240);
+    triggered.trigger = "Software";
+    AravisSource source("--rig aravis:127.0.0.1", "127.0.0.1", triggered);
+    EXPECT_THAT(source.describe(), HasSubstr("320x240 Mono8, triggered by Software"));
+    EXPECT_EQ(source.stallTimeoutSeconds(), 2.0);
+    // The camera would run free at 60 frames/s: on its trigger it gives a frame per pulse, and none without.
+    for (int i = 0; i < 3; ++i) {
+        camera.triggerSoftware();
+        const std::optional<core::Frame> frame = source.next();
+        ASSERT_TRUE(frame);
+        EXPECT_EQ(frame->image.size(), cv::Size(320, 240));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    EXPECT_THROW(source.next(), std::runtime_error);
+    EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+}
+
 TEST(AravisSource, RefusesWhatTheCameraCannotDoNamingIt) {
     SimulatedGigeCamera camera;
     // A setting it refuses is the configuration's fault; a camera that does not answer may yet come.
     EXPECT_EQ(
-        errorOf("127.0.0.1", CameraSettings{CameraPixels::Bgr8, std::nullopt, std::nullopt, std::nullopt}),
+        errorOf("127.0.0.1", withPixels(CameraPixels::Bgr8)),
         "bad input: --rig aravis:127.0.0.1: [Camera] PixelFormat: BGR8 is not offered; the camera offers "
         "BayerBG8, "
         "BayerGB8, BayerGR8, BayerRG8, Mono8, RGB8, Mono16");

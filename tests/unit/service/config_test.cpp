@@ -42,10 +42,11 @@ TEST(Config, ReadsEveryKey) {
     write(dir / "everytouchd.conf",
           "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
           "[Calibration]\nPath=/var/lib/et/cal.yml\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
-          "ExposureUs=4000\nGainDb=6\n");
+          "ExposureUs=4000\nGainDb=6\nRegion=640x480+16+8\nTrigger=Line1\n");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
     EXPECT_EQ(config.rig, "replay:/srv/rec");
-    EXPECT_EQ(config.camera, (io::CameraSettings{io::CameraPixels::BayerGr8, 119.5, 4000.0, 6.0}));
+    EXPECT_EQ(config.camera, (io::CameraSettings{io::CameraPixels::BayerGr8, 119.5, 4000.0, 6.0,
+                                                 cv::Rect(16, 8, 640, 480), "Line1"}));
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
@@ -102,6 +103,12 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
         {"[Camera]\nFrameRate=0.5\n", ":2: [Camera] FrameRate: must be from 1 to 1000 frames/s, found 0.5"},
         {"[Camera]\nExposureUs=fast\n", ":2: [Camera] ExposureUs: expected a number of microseconds"},
         {"[Camera]\nGainDb=-3\n", ":2: [Camera] GainDb: must be from 0 to 60 dB, found -3"},
+        {"[Camera]\nRegion=640x480+8\n",
+         ":2: [Camera] Region: expected WIDTHxHEIGHT or WIDTHxHEIGHT+X+Y in pixels, found \"640x480+8\""},
+        {"[Camera]\nRegion=32x480\n",
+         ":2: [Camera] Region: must be at least 64 pixels wide and high, found 32x480"},
+        {"[Camera]\nTrigger=Line 0\n",
+         ":2: [Camera] Trigger: expected off or a trigger source such as Line0"},
     };
     for (const auto& [text, expected] : cases) {
         write(dir / "everytouchd.conf", text);
