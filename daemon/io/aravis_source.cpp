@@ -30,28 +30,20 @@ void check(GErrorHandle& error, const std::string& input, const std::string& fie
         throw InputError(input, field, what + ": " + messageOf(error));
 }
 
-std::vector<std::string> offeredPixels(ArvCamera* camera) {
-    std::vector<std::string> offered;
-    guint count = 0;
-    GError* error = nullptr;
-    const char** names = arv_camera_dup_available_pixel_formats_as_strings(camera, &count, &error);
-    GErrorHandle owned(error);
-    for (guint i = 0; names && i < count; ++i)
-        offered.emplace_back(names[i]);
-    g_free(names);
-    return offered;
-}
+// What one of Aravis's arv_camera_dup_available_* functions lists: the array is ours, its strings the
+// camera's.
+using AvailableNames = const char** (*)(ArvCamera*, guint*, GError**);
 
-std::vector<std::string> offeredTriggerSources(ArvCamera* camera) {
-    std::vector<std::string> offered;
+std::vector<std::string> available(ArvCamera* camera, AvailableNames list) {
+    std::vector<std::string> names;
     guint count = 0;
     GError* error = nullptr;
-    const char** names = arv_camera_dup_available_trigger_sources(camera, &count, &error);
+    const char** array = list(camera, &count, &error);
     GErrorHandle owned(error);
-    for (guint i = 0; names && i < count; ++i)
-        offered.emplace_back(names[i]);
-    g_free(names);
-    return offered;
+    for (guint i = 0; array && i < count; ++i)
+        names.emplace_back(array[i]);
+    g_free(array);
+    return names;
 }
 
 std::string joined(const std::vector<std::string>& names) {
@@ -88,7 +80,8 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
                                  messageOf(error) + " (arv-tool-0.8 lists the cameras Aravis sees)");
 
     ArvCamera* camera = camera_.get();
-    const std::vector<std::string> offered = offeredPixels(camera);
+    const std::vector<std::string> offered =
+        available(camera, arv_camera_dup_available_pixel_formats_as_strings);
     const std::optional<CameraPixels> pixels =
         settings.pixels ? settings.pixels : preferredCameraPixels(offered);
     if (!pixels)
@@ -131,7 +124,7 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
         error.reset(raw);
         check(error, input, "[Camera] Trigger", "the camera cannot run free");
     } else if (settings.trigger) {
-        const std::vector<std::string> sources = offeredTriggerSources(camera);
+        const std::vector<std::string> sources = available(camera, arv_camera_dup_available_trigger_sources);
         if (std::find(sources.begin(), sources.end(), *settings.trigger) == sources.end())
             throw InputError(
                 input, "[Camera] Trigger",
