@@ -64,7 +64,15 @@ std::uint64_t framesMissedBetween(std::uint64_t last, std::uint64_t next) {
     return step >= 1 && step <= kMostMissed ? step - 1 : 0;
 }
 
-AravisSource::AravisSource(const std::string& input, const std::string& id, const CameraSettings& settings) {
+AravisSource::AravisSource(const std::string& input, const std::string& id, const CameraSettings& settings)
+    : input_(input), id_(id), settings_(settings) {
+    connect();
+}
+
+void AravisSource::connect() {
+    const std::string& input = input_;
+    const std::string& id = id_;
+    const CameraSettings& settings = settings_;
     GError* raw = nullptr;
     if (id.empty()) {
         arv_update_device_list();
@@ -185,9 +193,22 @@ AravisSource::AravisSource(const std::string& input, const std::string& id, cons
 }
 
 AravisSource::~AravisSource() {
-    // A camera that stopped answering is not asked again: each command would wait for its timeouts.
-    if (camera_ && !stalled_)
+    if (camera_)
         arv_camera_stop_acquisition(camera_.get(), nullptr);
+    if (releaser_.joinable())
+        releaser_.join();
+}
+
+void AravisSource::releaseLostCamera() {
+    if (releaser_.joinable())
+        releaser_.join();
+    // Aravis waits for its protocol's timeouts while it lets go of a camera that no longer answers (some
+    // 10 s for a GigE camera): on a thread of their own, so that the camera can be tried again meanwhile.
+    releaser_ = std::thread([camera = std::move(camera_), stream = std::move(stream_)]() mutable {
+        stream.reset();
+        camera.reset();
+    });
+    lastFrameId_.reset();
 }
 
 double AravisSource::stallTimeoutSeconds() const {
@@ -197,6 +218,15 @@ double AravisSource::stallTimeoutSeconds() const {
 }
 
 std::optional<core::Frame> AravisSource::next() {
+    if (!stream_) {
+        try {
+            connect();
+        } catch (const std::runtime_error& error) {
+            camera_.reset();
+            stream_.reset();
+            throw SourceLost(error.what());
+        }
+    }
     using Clock = std::chrono::steady_clock;
     const Clock::time_point giveUp = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                         std::chrono::duration<double>(stallTimeoutSeconds()));
@@ -232,12 +262,13 @@ std::optional<core::Frame> AravisSource::next() {
         frame.polarity = frame.index % 2 == 0 ? core::Polarity::Positive : core::Polarity::Negative;
         return frame;
     }
-    stalled_ = true;
     char waited[32];
     std::snprintf(waited, sizeof waited, "%.1f", stallTimeoutSeconds());
-    throw std::runtime_error(
+    const std::string problem =
         description_ + ": no complete frame for " + waited + " s" +
-        (trigger_.empty() ? std::string() : " (is the trigger on " + trigger_ + " running?)"));
+        (trigger_.empty() ? std::string() : " (is the trigger on " + trigger_ + " running?)");
+    releaseLostCamera();
+    throw SourceLost(problem);
 }
 
 }  // namespace everytouch::io

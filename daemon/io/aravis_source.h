@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include <arv.h>
 
@@ -34,7 +35,8 @@ public:
     AravisSource(const AravisSource&) = delete;
     AravisSource& operator=(const AravisSource&) = delete;
 
-    // Throws std::runtime_error when no complete frame came for stallTimeout().
+    // Throws SourceLost when no complete frame came for stallTimeoutSeconds(), and in each later call until
+    // the camera answers again with its settings.
     std::optional<core::Frame> next() override;
     // A camera describes only itself: the calibration store and the projector side know the rest.
     std::optional<RigDescription> rig() const override { return std::nullopt; }
@@ -42,11 +44,19 @@ public:
     std::uint64_t droppedFrames() const override { return dropped_.load(); }
 
     double frameRate() const { return frameRate_; }
-    // How long next() waits for a frame before it gives up on the camera: ten frame periods, at least
-    // half a second; two seconds on a trigger.
+    // How long next() waits for a frame before the camera counts as lost: ten frame periods, at least half a
+    // second; two seconds on a trigger.
     double stallTimeoutSeconds() const;
 
 private:
+    // Opens the camera, applies the settings and starts it; throws as the constructor does.
+    void connect();
+    // Lets go of a camera that stopped delivering, without waiting for it.
+    void releaseLostCamera();
+
+    std::string input_;
+    std::string id_;
+    CameraSettings settings_;
     GObjectHandle<ArvCamera> camera_;
     GObjectHandle<ArvStream> stream_;
     CameraPixels pixels_ = CameraPixels::Mono8;
@@ -56,7 +66,7 @@ private:
     std::string trigger_;  // the trigger source frames wait for; empty when free running
     std::optional<std::uint64_t> lastFrameId_;
     std::uint64_t nextIndex_ = 0;
-    bool stalled_ = false;  // next() gave up on the camera
+    std::thread releaser_;  // lets go of a lost camera's handles
     std::atomic<std::uint64_t> dropped_{0};
 };
 

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -13,8 +14,16 @@
 
 namespace everytouch::io {
 
+// Thrown by FrameSource::next when the source lost its camera (unplugged, powered off, its link down): the
+// stream is not over, and a later call tries to reach the camera again.
+class SourceLost : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
 // A stream of camera frames: a camera, the simulator or a recording. `next` blocks until the next frame
-// (paced in real time unless the source was asked to run fast) and returns nothing at the end of the stream.
+// (paced in real time unless the source was asked to run fast) and returns nothing at the end of the stream;
+// it throws SourceLost while a camera cannot be reached, any other exception when the stream cannot go on.
 class FrameSource {
 public:
     virtual ~FrameSource() = default;

@@ -283,7 +283,7 @@ DaemonState Daemon::state() const {
     if (calibration_)
         return DaemonState::Calibrating;
     // Detection runs on every pair once calibrated with the code known, unless a stage keeps failing.
-    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing())
+    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing() || loop_->sourceLost())
         return DaemonState::Degraded;
     return DaemonState::Running;
 }
@@ -313,9 +313,13 @@ void Daemon::refreshState() {
         reportedCalibrated_ = now;
         changed.push_back(bus::kPropertyCalibrated);
     }
-    if (changed.empty())
+    // A camera lost or back changes what the status says even where the state stays degraded.
+    const bool sourceLost = loop_ && loop_->sourceLost();
+    const bool statusChanged = sourceLost != reportedSourceLost_;
+    reportedSourceLost_ = sourceLost;
+    if (changed.empty() && !statusChanged)
         return;
-    if (bus_)
+    if (bus_ && !changed.empty())
         bus_->propertiesChanged(changed);
     notifyStatus();
 }
@@ -329,6 +333,10 @@ void Daemon::notifyStatus() {
         case DaemonState::Running:
         case DaemonState::Degraded: {
             const LoopStatistics statistics = loop_->statistics();
+            if (const std::optional<std::string> lost = loop_->sourceLost()) {
+                status = "Camera lost, asking it again: " + *lost;
+                break;
+            }
             status = (!calibrated()        ? "Not calibrated (run everytouch-calib calibrate), on "
                       : loop_->detecting() ? "Running on "
                                            : "Not detecting (" + loop_->idleReason() + "), on ") +

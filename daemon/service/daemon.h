@@ -142,6 +142,7 @@ private:
     bool ready_ = false;
     DaemonState reportedState_ = DaemonState::Starting;
     bool reportedCalibrated_ = false;
+    bool reportedSourceLost_ = false;
     std::uint64_t contactsVersion_ = 0;
     std::chrono::steady_clock::time_point lastContactsSignal_;
     std::uint64_t watchdogUsec_ = 0;

@@ -17,6 +17,9 @@ using Clock = std::chrono::steady_clock;
 constexpr double kSmoothingSeconds = 1.0;
 // The pipeline thread wakes at least this often, so its heartbeat shows it is alive while no frame comes.
 constexpr std::chrono::milliseconds kPipelineWake{100};
+// A lost camera is asked again after this, then after twice as long each time, up to the most.
+constexpr std::chrono::milliseconds kFirstReconnectWait{250};
+constexpr std::chrono::milliseconds kMostReconnectWait{5000};
 // Pipeline times kept for the median and the 99th percentile: a minute at 120 Hz.
 constexpr std::size_t kPipelineSamples = 8192;
 
@@ -57,7 +60,11 @@ void FrameLoop::start() {
 }
 
 void FrameLoop::stop() {
-    stopping_ = true;
+    {
+        std::lock_guard lock(mutex_);
+        stopping_ = true;
+    }
+    stopRequested_.notify_all();
     queue_.close();
     if (camera_.joinable())
         camera_.join();
@@ -74,6 +81,42 @@ void FrameLoop::fail(const std::string& problem) {
 std::optional<std::string> FrameLoop::failure() const {
     std::lock_guard lock(mutex_);
     return failure_;
+}
+
+std::optional<std::string> FrameLoop::sourceLost() const {
+    std::lock_guard lock(mutex_);
+    return sourceLost_;
+}
+
+bool FrameLoop::waitForLostSource(const std::string& reason, std::chrono::milliseconds& backOff) {
+    std::unique_lock lock(mutex_);
+    const bool first = !sourceLost_;
+    sourceLost_ = reason;
+    if (first) {
+        lock.unlock();
+        ET_LOG(Error) << "camera: " << reason << "; every contact is released, and the camera is asked again "
+                      << "until it answers";
+        // After the frames already queued, so that their contacts go too.
+        QueuedFrame marker;
+        marker.sourceLost = true;
+        queue_.push(std::move(marker));
+        notify_();
+        lock.lock();
+    }
+    stopRequested_.wait_for(lock, backOff, [this] { return stopping_.load(); });
+    backOff = std::min(2 * backOff, kMostReconnectWait);
+    return !stopping_;
+}
+
+void FrameLoop::sourceBack() {
+    {
+        std::lock_guard lock(mutex_);
+        if (!sourceLost_)
+            return;
+        sourceLost_.reset();
+    }
+    ET_LOG(Notice) << "camera: frames come again";
+    notify_();
 }
 
 std::string FrameLoop::idleReason() const {
@@ -121,6 +164,7 @@ void FrameLoop::setSettings(core::PipelineSettings settings) {
 }
 
 void FrameLoop::runCamera() {
+    std::chrono::milliseconds backOff = kFirstReconnectWait;
     while (!stopping_) {
         {
             std::lock_guard lock(mutex_);
@@ -132,6 +176,8 @@ void FrameLoop::runCamera() {
             std::optional<core::Frame> frame = source_.next();
             if (!frame)
                 break;
+            sourceBack();
+            backOff = kFirstReconnectWait;
             item.frame = std::move(*frame);
             if (recorder_) {
                 recorder_->addFrame(item.frame);
@@ -140,6 +186,10 @@ void FrameLoop::runCamera() {
                 if (const auto mask = source_.truthMask())
                     recorder_->addMask(item.frame.index, *mask);
             }
+        } catch (const io::SourceLost& lost) {
+            if (!waitForLostSource(lost.what(), backOff))
+                break;
+            continue;
         } catch (const std::exception& error) {
             fail(std::string("camera: ") + error.what());
             break;
@@ -241,6 +291,12 @@ void FrameLoop::runPipeline() {
                 break;
             if (result == FrameQueue::PopResult::Timeout || stopping_)
                 continue;
+            if (item.sourceLost) {
+                pipeline_.reset();
+                pairer_.reset();
+                publish(lastIndex, lastTimestampUs, noContacts);
+                continue;
+            }
             lastIndex = item.frame.index;
             lastTimestampUs = item.frame.timestampUs;
             std::optional<core::FramePair> pair = pairer_.push(item.frame);

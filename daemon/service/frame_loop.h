@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
@@ -71,6 +72,9 @@ public:
     bool finished() const { return finished_; }
     // Why the loop failed (camera, recording, sink); nothing after a normal end.
     std::optional<std::string> failure() const;
+    // Why the source's camera cannot be reached while the loop waits for it to come back; nothing while
+    // frames come.
+    std::optional<std::string> sourceLost() const;
 
     LoopStatistics statistics() const;
     // The current contacts and a number that changes whenever they do.
@@ -93,6 +97,10 @@ private:
     void processPair(const core::FramePair& pair, const core::PipelineSettings& settings);
     void recordPipelineTime(double ms);
     void fail(const std::string& problem);
+    // The camera thread's side of a lost camera: says so once, has the contacts released, and waits
+    // `backOff` (doubled for the next time) before the source is asked again. False when stopping.
+    bool waitForLostSource(const std::string& reason, std::chrono::milliseconds& backOff);
+    void sourceBack();
 
     io::FrameSource& source_;
     core::PairPipeline& pipeline_;
@@ -120,6 +128,8 @@ private:
     core::Contacts contacts_;
     std::uint64_t contactsVersion_ = 0;
     std::optional<std::string> failure_;
+    std::optional<std::string> sourceLost_;
+    std::condition_variable stopRequested_;  // wakes the camera thread waiting for a lost source
     core::PipelineSettings settings_;
     std::uint64_t settingsVersion_ = 0;
     std::string idleReason_;

@@ -15,6 +15,8 @@ namespace everytouch::service {
 struct QueuedFrame {
     core::Frame frame;
     std::chrono::steady_clock::time_point arrival;
+    // No frame: the source lost its camera after the frames before this one. Nothing they showed holds.
+    bool sourceLost = false;
 };
 
 // Hands camera frames from the camera thread to the pipeline thread through a fixed ring of slots. A live

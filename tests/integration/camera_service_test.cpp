@@ -35,18 +35,22 @@ class CameraServiceTest : public ::testing::Test {
 protected:
     static constexpr int kRememberedFrames = 120;
 
-    CameraServiceTest()
-        : bus_(POLICY_FILE, false),
-          camera_(cv::Size(320, 240), [this](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
-              // A ramp that moves by a level each frame: every frame differs from the last few hundred.
-              for (int y = 0; y < image.rows; ++y)
-                  for (int x = 0; x < image.cols; ++x)
-                      image.at<uchar>(y, x) = static_cast<uchar>((x + y + frameId) % 256);
-              std::lock_guard lock(mutex_);
-              sent_.push_back(image.clone());
-              if (sent_.size() > kRememberedFrames)
-                  sent_.pop_front();
-          }) {}
+    CameraServiceTest() : bus_(POLICY_FILE, false) { plugIn(); }
+
+    // A camera at 127.0.0.1 that films a ramp moving by a level each frame: every frame differs from the
+    // last few hundred.
+    void plugIn() {
+        camera_ = std::make_unique<test::FakeGigeCamera>(
+            cv::Size(320, 240), [this](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+                for (int y = 0; y < image.rows; ++y)
+                    for (int x = 0; x < image.cols; ++x)
+                        image.at<uchar>(y, x) = static_cast<uchar>((x + y + frameId) % 256);
+                std::lock_guard lock(mutex_);
+                sent_.push_back(image.clone());
+                if (sent_.size() > kRememberedFrames)
+                    sent_.pop_front();
+            });
+    }
 
     void TearDown() override {
         if (daemon_ && HasFailure())
@@ -66,8 +70,42 @@ protected:
             std::vector<std::pair<std::string, std::string>>{{"NOTIFY_SOCKET", notify_->path().string()}});
     }
 
+    // Waits for a status message systemd would show that begins with `prefix`.
+    bool waitForStatus(const std::string& prefix) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline) {
+            for (const std::string& message : notify_->messages())
+                if (message.starts_with(prefix) || message.find("\n" + prefix) != std::string::npos)
+                    return true;
+            std::this_thread::sleep_for(50ms);
+        }
+        return false;
+    }
+
+    bool waitForLog(const std::string& text) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (daemon_->output().find(text) != std::string::npos)
+                return true;
+            std::this_thread::sleep_for(50ms);
+        }
+        return false;
+    }
+
     std::string get(const std::string& name) {
         return test::runProcess(test::property("get-property", name)).out;
+    }
+
+    // Whether a `camera` snapshot shows a frame the camera sent lately.
+    bool snapshotShowsTheCamera() {
+        const std::filesystem::path file = dir_ / "camera.png";
+        const test::ProcessResult snapshot =
+            test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", file.string()});
+        EXPECT_EQ(snapshot.exitCode, 0) << snapshot.err;
+        const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+        EXPECT_EQ(image.type(), CV_8UC1);
+        EXPECT_EQ(image.size(), cv::Size(320, 240));
+        return !image.empty() && sentRecently(image);
     }
 
     bool sentRecently(const cv::Mat& image) {
@@ -82,7 +120,7 @@ protected:
     test::PrivateBus bus_;
     std::mutex mutex_;
     std::deque<cv::Mat> sent_;
-    test::FakeGigeCamera camera_;
+    std::unique_ptr<test::FakeGigeCamera> camera_;
     std::unique_ptr<test::NotifySocket> notify_;
     std::unique_ptr<test::BackgroundProcess> daemon_;
 };
@@ -103,14 +141,7 @@ TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
     EXPECT_EQ(get("DroppedFrames"), "t 0\n");
 
     // What the camera sees, as the camera sent it.
-    const std::filesystem::path file = dir_ / "camera.png";
-    const test::ProcessResult snapshot =
-        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", file.string()});
-    ASSERT_EQ(snapshot.exitCode, 0) << snapshot.err;
-    const cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-    ASSERT_EQ(image.type(), CV_8UC1);
-    ASSERT_EQ(image.size(), cv::Size(320, 240));
-    EXPECT_TRUE(sentRecently(image)) << "the snapshot is no frame the camera sent lately";
+    EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent lately";
 
     const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
     EXPECT_THAT(status.out, HasSubstr("State:         degraded"));
@@ -120,12 +151,21 @@ TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
 }
 
-TEST_F(CameraServiceTest, ACameraThatGoesAwayStopsTheDaemonWithAFailureForSystemdToRestartIt) {
+TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARestart) {
     startDaemon("PixelFormat=Mono8\nFrameRate=60\n");
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
-    camera_.unplug();
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 1);
-    EXPECT_THAT(daemon_->output(), HasSubstr("no complete frame for 0.5 s"));
+    camera_->unplug();
+    ASSERT_TRUE(
+        waitForStatus("STATUS=Camera lost, asking it again: camera Aravis Fake (serial everytouch-test), "
+                      "320x240 Mono8 at 60 frames/s: no complete frame for 0.5 s"))
+        << "the status does not say the camera is lost";
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    plugIn();
+    ASSERT_TRUE(waitForLog("camera: frames come again")) << "the camera was not taken back";
+    EXPECT_TRUE(daemon_->running());
+    EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent after it came back";
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
 }
 
 TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {

@@ -127,6 +127,28 @@ private:
     std::atomic<std::uint64_t> lost_{0};
 };
 
+// A camera that goes away after frame 6 for two attempts to reach it, then comes back.
+class AbsentForAWhileSource final : public io::FrameSource {
+public:
+    explicit AbsentForAWhileSource(const std::filesystem::path& recording) : recording_(recording, false) {}
+
+    std::optional<core::Frame> next() override {
+        if (delivered_ == 7 && absences_ < 2) {
+            ++absences_;
+            throw io::SourceLost("the camera does not answer");
+        }
+        ++delivered_;
+        return recording_.next();
+    }
+    std::optional<io::RigDescription> rig() const override { return recording_.rig(); }
+    std::string describe() const override { return "an unreliable " + recording_.describe(); }
+
+private:
+    io::ReplaySource recording_;
+    int delivered_ = 0;
+    int absences_ = 0;
+};
+
 class FrameLoopTest : public ::testing::Test {
 protected:
     void SetUp() override { test::writeCodedRecording(dir_ / "recording", test::smallRig(), 20, 8333); }
@@ -193,6 +215,32 @@ TEST_F(FrameLoopTest, FramesTheSourceLostCountAsDropped) {
     const LoopStatistics statistics = loop.statistics();
     EXPECT_EQ(statistics.frames, 14u);  // of 20
     EXPECT_EQ(statistics.dropped, 6u);
+}
+
+TEST_F(FrameLoopTest, ALostCameraReleasesEveryContactAndIsWaitedFor) {
+    AbsentForAWhileSource source(dir_ / "recording");
+    pipeline_.touchFrom = 2;
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    loop.start();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.sourceLost().has_value(); }, 30s));
+    EXPECT_EQ(*loop.sourceLost(), "the camera does not answer");
+    // Its last frame's contact goes (a report of no contact at frame 6), before the camera is back.
+    ASSERT_TRUE(notifications_.waitUntil(
+        [&] {
+            const std::vector<std::uint64_t> indices = sink.indices();
+            return std::count(indices.begin(), indices.end(), 6u) == 2;
+        },
+        30s));
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    EXPECT_FALSE(loop.failure());
+    EXPECT_FALSE(loop.sourceLost());
+    EXPECT_EQ(loop.statistics().frames, 20u);
+    const std::vector<std::uint64_t> touched = sink.touchedIn();
+    EXPECT_EQ(std::count(touched.begin(), touched.end(), 6u), 1);
+    EXPECT_EQ(touched.back(), 19u);  // touching again once frames came back
 }
 
 TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
