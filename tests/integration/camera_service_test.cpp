@@ -82,15 +82,7 @@ protected:
         return false;
     }
 
-    bool waitForLog(const std::string& text) {
-        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
-        while (std::chrono::steady_clock::now() < deadline) {
-            if (daemon_->output().find(text) != std::string::npos)
-                return true;
-            std::this_thread::sleep_for(50ms);
-        }
-        return false;
-    }
+    bool waitForLog(const std::string& text) { return daemon_->waitForOutput(text, kStartTimeout); }
 
     std::string get(const std::string& name) {
         return test::runProcess(test::property("get-property", name)).out;

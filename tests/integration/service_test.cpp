@@ -198,15 +198,7 @@ protected:
         return false;
     }
 
-    bool waitForLog(const std::string& text) {
-        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
-        while (std::chrono::steady_clock::now() < deadline) {
-            if (daemon_->output().find(text) != std::string::npos)
-                return true;
-            std::this_thread::sleep_for(20ms);
-        }
-        return false;
-    }
+    bool waitForLog(const std::string& text) { return daemon_->waitForOutput(text, kStartTimeout); }
 
     std::string get(const std::string& name) {
         const test::ProcessResult result = test::runProcess(property("get-property", name));

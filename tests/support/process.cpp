@@ -144,4 +144,14 @@ std::optional<int> BackgroundProcess::wait(std::chrono::milliseconds timeout) {
     return exitCode_;
 }
 
+bool BackgroundProcess::waitForOutput(const std::string& text, std::chrono::milliseconds timeout) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+        if (output().find(text) != std::string::npos)
+            return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return output().find(text) != std::string::npos;
+}
+
 }  // namespace everytouch::test

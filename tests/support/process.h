@@ -41,6 +41,8 @@ public:
     bool running() { return !wait(std::chrono::milliseconds(0)); }
     // What it has written so far.
     std::string output() const;
+    // Waits up to `timeout` for `text` to appear in what it writes; true when it did.
+    bool waitForOutput(const std::string& text, std::chrono::milliseconds timeout) const;
 
 private:
     std::filesystem::path outputFile_;
