@@ -66,13 +66,20 @@ int status() {
         return report(*failure);
     const auto& values = std::get<0>(properties);
     const std::pair<const char*, const char*> rows[] = {
-        {bus::kPropertyState, "State"},           {bus::kPropertyRig, "Rig"},
-        {bus::kPropertyCalibrated, "Calibrated"}, {bus::kPropertyTouchHeightMm, "Touch height"},
-        {bus::kPropertyFrameRate, "Frame rate"},  {bus::kPropertyLatencyMs, "Latency"},
-        {bus::kPropertyDroppedFrames, "Dropped"}, {bus::kPropertyDevicePath, "Touch device"},
+        {bus::kPropertyState, "State"},
+        {bus::kPropertyStateReason, "Why"},
+        {bus::kPropertyRig, "Rig"},
+        {bus::kPropertyCalibrated, "Calibrated"},
+        {bus::kPropertyTouchHeightMm, "Touch height"},
+        {bus::kPropertyFrameRate, "Frame rate"},
+        {bus::kPropertyLatencyMs, "Latency"},
+        {bus::kPropertyDroppedFrames, "Dropped"},
+        {bus::kPropertyDevicePath, "Touch device"},
     };
     for (const auto& [property, label] : rows)
-        if (const auto it = values.find(property); it != values.end())
+        if (const auto it = values.find(property);
+            it != values.end() &&
+            !(property == bus::kPropertyStateReason && describe(property, it->second).empty()))
             std::printf("%-14s %s\n", (std::string(label) + ":").c_str(),
                         describe(property, it->second).c_str());
     return calib::kExitOk;

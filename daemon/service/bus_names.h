@@ -23,6 +23,7 @@ inline constexpr const char* kErrorInvalidConfig = EVERYTOUCH_BUS_ROOT ".Error.I
 // Properties.
 inline constexpr const char* kPropertyApiVersion = "APIVersion";
 inline constexpr const char* kPropertyState = "State";
+inline constexpr const char* kPropertyStateReason = "StateReason";
 inline constexpr const char* kPropertyRig = "Rig";
 inline constexpr const char* kPropertyCalibrated = "Calibrated";
 inline constexpr const char* kPropertyDisplaySize = "DisplaySize";

@@ -1,5 +1,6 @@
 #include "service/bus_service.h"
 
+#include <cerrno>
 #include <cstring>
 #include <exception>
 
@@ -87,6 +88,15 @@ int getApiVersion(sd_bus*, const char*, const char*, const char*, sd_bus_message
 int getState(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
              sd_bus_error*) noexcept {
     return sd_bus_message_append(reply, "s", toString(serviceOf(userdata).daemon().state()));
+}
+
+int getStateReason(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                   sd_bus_error*) noexcept {
+    try {
+        return sd_bus_message_append(reply, "s", serviceOf(userdata).daemon().stateReason().c_str());
+    } catch (const std::exception&) {
+        return -ENOMEM;
+    }
 }
 
 int getRig(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
@@ -212,6 +222,7 @@ const sd_bus_vtable kVtable[] = {
     SD_BUS_VTABLE_START(0),
     SD_BUS_PROPERTY(bus::kPropertyApiVersion, "u", getApiVersion, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY(bus::kPropertyState, "s", getState, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
+    SD_BUS_PROPERTY(bus::kPropertyStateReason, "s", getStateReason, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     SD_BUS_PROPERTY(bus::kPropertyRig, "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY(bus::kPropertyCalibrated, "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     // Statistics change with every frame: clients poll them instead of being flooded with signals.

@@ -4,6 +4,7 @@
 #include <systemd/sd-daemon.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -288,6 +289,21 @@ DaemonState Daemon::state() const {
     return DaemonState::Running;
 }
 
+std::string Daemon::stateReason() const {
+    switch (state()) {
+        case DaemonState::Degraded:
+            if (const std::optional<std::string> lost = loop_ ? loop_->sourceLost() : std::nullopt)
+                return "camera lost, asking it again: " + *lost;
+            if (!calibrated())
+                return "not calibrated (run everytouch-calib calibrate)";
+            return "not detecting (" + (loop_ ? loop_->idleReason() : std::string("no frames yet")) + ")";
+        case DaemonState::Failed:
+            return loop_ ? loop_->failure().value_or("") : std::string();
+        default:
+            return {};
+    }
+}
+
 core::PipelineSettings Daemon::pipelineSettings() const {
     return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_, calibration_ == nullptr};
 }
@@ -313,13 +329,14 @@ void Daemon::refreshState() {
         reportedCalibrated_ = now;
         changed.push_back(bus::kPropertyCalibrated);
     }
-    // A camera lost or back changes what the status says even where the state stays degraded.
-    const bool sourceLost = loop_ && loop_->sourceLost();
-    const bool statusChanged = sourceLost != reportedSourceLost_;
-    reportedSourceLost_ = sourceLost;
-    if (changed.empty() && !statusChanged)
+    // A camera lost or back changes why the state is degraded while it stays degraded.
+    if (std::string now = stateReason(); now != reportedReason_) {
+        reportedReason_ = std::move(now);
+        changed.push_back(bus::kPropertyStateReason);
+    }
+    if (changed.empty())
         return;
-    if (bus_ && !changed.empty())
+    if (bus_)
         bus_->propertiesChanged(changed);
     notifyStatus();
 }
@@ -333,15 +350,17 @@ void Daemon::notifyStatus() {
         case DaemonState::Running:
         case DaemonState::Degraded: {
             const LoopStatistics statistics = loop_->statistics();
-            if (const std::optional<std::string> lost = loop_->sourceLost()) {
-                status = "Camera lost, asking it again: " + *lost;
+            const std::string rates = rigName_ + ": " + formatDouble("%.1f", statistics.frameRate) +
+                                      " frames/s, " + std::to_string(statistics.dropped) + " dropped";
+            if (state() == DaemonState::Running) {
+                status = "Running on " + rates;
                 break;
             }
-            status = (!calibrated()        ? "Not calibrated (run everytouch-calib calibrate), on "
-                      : loop_->detecting() ? "Running on "
-                                           : "Not detecting (" + loop_->idleReason() + "), on ") +
-                     rigName_ + ": " + formatDouble("%.1f", statistics.frameRate) + " frames/s, " +
-                     std::to_string(statistics.dropped) + " dropped";
+            status = stateReason();
+            status[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(status[0])));
+            // A lost camera has no rates to tell.
+            if (!loop_->sourceLost())
+                status += ", on " + rates;
             break;
         }
         case DaemonState::Calibrating:

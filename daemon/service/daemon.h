@@ -66,6 +66,8 @@ public:
 
     // What the bus shows. Main thread only, like everything below.
     DaemonState state() const;
+    // Why the state is degraded or failed, in words; empty otherwise.
+    std::string stateReason() const;
     const std::string& rig() const { return rigName_; }
     // The active calibration, where the display's size and its size on the table come from; none when not
     // calibrated.
@@ -142,7 +144,7 @@ private:
     bool ready_ = false;
     DaemonState reportedState_ = DaemonState::Starting;
     bool reportedCalibrated_ = false;
-    bool reportedSourceLost_ = false;
+    std::string reportedReason_;
     std::uint64_t contactsVersion_ = 0;
     std::chrono::steady_clock::time_point lastContactsSignal_;
     std::uint64_t watchdogUsec_ = 0;

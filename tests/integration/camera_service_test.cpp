@@ -138,6 +138,7 @@ TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
     const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
     EXPECT_THAT(status.out, HasSubstr("State:         degraded"));
     EXPECT_THAT(status.out, HasSubstr("Calibrated:    no"));
+    EXPECT_THAT(status.out, HasSubstr("Why:           not calibrated (run everytouch-calib calibrate)\n"));
 
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
@@ -152,10 +153,12 @@ TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARe
                       "320x240 Mono8 at 60 frames/s: no complete frame for 0.5 s"))
         << "the status does not say the camera is lost";
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    EXPECT_THAT(get("StateReason"), ::testing::StartsWith("s \"camera lost, asking it again: "));
     plugIn();
     ASSERT_TRUE(waitForLog("camera: frames come again")) << "the camera was not taken back";
     EXPECT_TRUE(daemon_->running());
     EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent after it came back";
+    EXPECT_EQ(get("StateReason"), "s \"not calibrated (run everytouch-calib calibrate)\"\n");
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
 }
