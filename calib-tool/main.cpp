@@ -76,12 +76,14 @@ int status() {
         {bus::kPropertyDroppedFrames, "Dropped"},
         {bus::kPropertyDevicePath, "Touch device"},
     };
-    for (const auto& [property, label] : rows)
-        if (const auto it = values.find(property);
-            it != values.end() &&
-            !(property == bus::kPropertyStateReason && describe(property, it->second).empty()))
-            std::printf("%-14s %s\n", (std::string(label) + ":").c_str(),
-                        describe(property, it->second).c_str());
+    for (const auto& [property, label] : rows) {
+        const auto it = values.find(property);
+        if (it == values.end())
+            continue;
+        // A property with nothing to say (no reason while running) takes no line.
+        if (const std::string text = describe(property, it->second); !text.empty())
+            std::printf("%-14s %s\n", (std::string(label) + ":").c_str(), text.c_str());
+    }
     return calib::kExitOk;
 }
 

@@ -24,8 +24,13 @@ std::string messageOf(const GErrorHandle& error) {
     return error && error->message ? error->message : "unknown error";
 }
 
-// Throws InputError for `field` when `error` was set.
-void check(GErrorHandle& error, const std::string& input, const std::string& field, const std::string& what) {
+// Runs one Aravis call that reports its failure through a GError; throws InputError naming `field` when it
+// fails.
+template <typename Call>
+void require(const std::string& input, const std::string& field, const std::string& what, Call call) {
+    GError* raw = nullptr;
+    call(&raw);
+    const GErrorHandle error(raw);
     if (error)
         throw InputError(input, field, what + ": " + messageOf(error));
 }
@@ -101,69 +106,59 @@ void AravisSource::connect() {
             input, "[Camera] PixelFormat",
             std::string(cameraPixelsName(*pixels)) + " is not offered; the camera offers " + joined(offered));
     pixels_ = *pixels;
-    arv_camera_set_pixel_format_from_string(camera, std::string(cameraPixelsName(pixels_)).c_str(), &raw);
-    error.reset(raw);
-    check(error, input, "[Camera] PixelFormat", "the camera refused it");
+    const std::string pixelsName(cameraPixelsName(pixels_));
+    require(input, "[Camera] PixelFormat", "the camera refused it", [&](GError** error) {
+        arv_camera_set_pixel_format_from_string(camera, pixelsName.c_str(), error);
+    });
 
-    if (settings.region) {
-        const cv::Rect& region = *settings.region;
-        arv_camera_set_region(camera, region.x, region.y, region.width, region.height, &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] Region", "the camera refused it");
-    }
-    if (settings.frameRate) {
-        arv_camera_set_frame_rate(camera, *settings.frameRate, &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] FrameRate", "the camera refused it");
-    }
-    if (settings.exposureUs) {
-        arv_camera_set_exposure_time(camera, *settings.exposureUs, &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] ExposureUs", "the camera refused it");
-    }
-    if (settings.gainDb) {
-        arv_camera_set_gain(camera, *settings.gainDb, &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] GainDb", "the camera refused it");
-    }
+    if (const std::optional<cv::Rect>& region = settings.region)
+        require(input, "[Camera] Region", "the camera refused it", [&](GError** error) {
+            arv_camera_set_region(camera, region->x, region->y, region->width, region->height, error);
+        });
+    if (settings.frameRate)
+        require(input, "[Camera] FrameRate", "the camera refused it",
+                [&](GError** error) { arv_camera_set_frame_rate(camera, *settings.frameRate, error); });
+    if (settings.exposureUs)
+        require(input, "[Camera] ExposureUs", "the camera refused it",
+                [&](GError** error) { arv_camera_set_exposure_time(camera, *settings.exposureUs, error); });
+    if (settings.gainDb)
+        require(input, "[Camera] GainDb", "the camera refused it",
+                [&](GError** error) { arv_camera_set_gain(camera, *settings.gainDb, error); });
     // Last: setting the frame rate turns the frame trigger off on some cameras (Aravis does so for them).
     if (settings.trigger == "off") {
-        arv_camera_clear_triggers(camera, &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] Trigger", "the camera cannot run free");
+        require(input, "[Camera] Trigger", "the camera cannot run free",
+                [&](GError** error) { arv_camera_clear_triggers(camera, error); });
     } else if (settings.trigger) {
         const std::vector<std::string> sources = available(camera, arv_camera_dup_available_trigger_sources);
         if (std::find(sources.begin(), sources.end(), *settings.trigger) == sources.end())
             throw InputError(
                 input, "[Camera] Trigger",
                 "the camera has no trigger source " + *settings.trigger + "; it offers " + joined(sources));
-        arv_camera_set_trigger(camera, settings.trigger->c_str(), &raw);
-        error.reset(raw);
-        check(error, input, "[Camera] Trigger", "the camera refused it");
+        require(input, "[Camera] Trigger", "the camera refused it",
+                [&](GError** error) { arv_camera_set_trigger(camera, settings.trigger->c_str(), error); });
         trigger_ = *settings.trigger;
     }
-    arv_camera_set_acquisition_mode(camera, ARV_ACQUISITION_MODE_CONTINUOUS, &raw);
-    error.reset(raw);
-    check(error, input, "", "the camera cannot run continuously");
+    require(input, "", "the camera cannot run continuously", [&](GError** error) {
+        arv_camera_set_acquisition_mode(camera, ARV_ACQUISITION_MODE_CONTINUOUS, error);
+    });
     if (arv_camera_is_gv_device(camera)) {
-        // The largest packet the link carries: fewer packets a frame, fewer lost.
+        // The largest packet the link carries: fewer packets a frame, fewer lost. A link that takes none
+        // larger keeps the default.
         arv_camera_gv_auto_packet_size(camera, &raw);
         error.reset(raw);
     }
 
     gint x = 0, y = 0, width = 0, height = 0;
-    arv_camera_get_region(camera, &x, &y, &width, &height, &raw);
-    error.reset(raw);
-    check(error, input, "", "the camera does not tell its image size");
-    size_ = cv::Size(width, height);
+    require(input, "", "the camera does not tell its image size",
+            [&](GError** error) { arv_camera_get_region(camera, &x, &y, &width, &height, error); });
     frameRate_ = arv_camera_get_frame_rate(camera, &raw);
     error.reset(raw);
     if (error || !(frameRate_ > 0.0))
         frameRate_ = 0.0;
-    const std::size_t payload = arv_camera_get_payload(camera, &raw);
-    error.reset(raw);
-    check(error, input, "", "the camera does not tell its frame size");
-    if (payload < cameraPixelsBytes(size_, pixels_))
+    std::size_t payload = 0;
+    require(input, "", "the camera does not tell its frame size",
+            [&](GError** error) { payload = arv_camera_get_payload(camera, error); });
+    if (payload < cameraPixelsBytes(cv::Size(width, height), pixels_))
         throw InputError(input, "",
                          "the camera's frames (" + std::to_string(payload) + " bytes) are smaller than " +
                              std::to_string(width) + "x" + std::to_string(height) + " " +
@@ -188,7 +183,7 @@ void AravisSource::connect() {
     description_ =
         std::string("camera ") + (vendor ? vendor : "?") + " " + (model ? model : "?") + " (serial " +
         (serial ? serial : "?") + "), " + std::to_string(width) + "x" + std::to_string(height) + " " +
-        std::string(cameraPixelsName(pixels_)) +
+        pixelsName +
         (trigger_.empty() ? " at " + std::string(rate) + " frames/s" : ", triggered by " + trigger_);
 }
 

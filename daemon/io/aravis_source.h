@@ -43,7 +43,6 @@ public:
     std::string describe() const override { return description_; }
     std::uint64_t droppedFrames() const override { return dropped_.load(); }
 
-    double frameRate() const { return frameRate_; }
     // How long next() waits for a frame before the camera counts as lost: ten frame periods, at least half a
     // second; two seconds on a trigger.
     double stallTimeoutSeconds() const;
@@ -60,7 +59,6 @@ private:
     GObjectHandle<ArvCamera> camera_;
     GObjectHandle<ArvStream> stream_;
     CameraPixels pixels_ = CameraPixels::Mono8;
-    cv::Size size_;
     double frameRate_ = 0.0;
     std::string description_;
     std::string trigger_;  // the trigger source frames wait for; empty when free running
