@@ -73,6 +73,8 @@ public:
     // The rig: its calibration and code (pattern CV_8UC1 0/1, projector size). The Code method needs it.
     void setRig(const Calibration& calibration, const cv::Mat& pattern);
     bool hasRig() const { return !tableCode_.predicted.empty(); }
+    // The table's code as the camera sees it, for the rig set.
+    const TableCode& tableCode() const { return tableCode_; }
 
     // texture: T (CV_8UC3 or CV_8UC1), subtraction: S (CV_16SC1), camera size (core/code_image.h). mask:
     // receives CV_8UC1, 255 where the camera sees a hand. After the first frames of a size, the Code method

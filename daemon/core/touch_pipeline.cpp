@@ -76,6 +76,7 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
         rigPattern_.data == settings.pattern.data && rigPattern_.size() == settings.pattern.size())
         return;
     segmenter_.setRig(calibration, settings.pattern);
+    polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
     height_.setRig(calibration, settings.pattern);
     const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
     options_.fingertips.fingerWidthPx = rig.fingerWidthPx;
@@ -94,28 +95,37 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     result_.frameIndex = pair.latest().index;
     result_.sceneStill = false;
     result_.timestampUs = pair.latest().timestampUs;
-    computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
-    result_.handMask.create(result_.texture.size(), CV_8UC1);
-    if (!settings.detect || !settings.calibration || settings.pattern.empty()) {
+    result_.handMask.create(pair.positive.image.size(), CV_8UC1);
+    const auto idle = [&](const char* reason) -> const PipelineResult& {
+        computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
         result_.detecting = false;
-        result_.idleReason = !settings.detect        ? "the projector shows calibration images"
-                             : !settings.calibration ? "not calibrated"
-                                                     : "the projected code is not known";
+        result_.idleReason = reason;
+        result_.framesSwapped = false;
         fill(result_.handMask, 0);
         reset();
         return result_;
-    }
+    };
+    if (!settings.detect)
+        return idle("the projector shows calibration images");
+    if (!settings.calibration)
+        return idle("not calibrated");
+    if (settings.pattern.empty())
+        return idle("the projected code is not known");
     if (settings.pattern.size() != settings.calibration->projectorSize ||
-        result_.texture.size() != settings.calibration->cameraSize) {
-        result_.detecting = false;
-        result_.idleReason = "the camera or the code does not match the calibration's sizes";
-        fill(result_.handMask, 0);
-        reset();
-        return result_;
-    }
+        pair.positive.image.size() != settings.calibration->cameraSize)
+        return idle("the camera or the code does not match the calibration's sizes");
     adoptRig(settings);
     result_.detecting = true;
     result_.idleReason.clear();
+    // The frames in the order the code's sign says: a pair made the wrong way round is made again.
+    FramePair ordered = polarityLock_.swapped() ? swappedPair(pair) : pair;
+    computeSubtractionAndTexture(ordered, result_.subtraction, result_.texture);
+    if (polarityLock_.relock(result_.subtraction)) {
+        ordered = swappedPair(ordered);
+        computeSubtractionAndTexture(ordered, result_.subtraction, result_.texture);
+    }
+    result_.framesSwapped = polarityLock_.swapped();
+    result_.polaritySwaps = polarityLock_.swaps();
     // The last pair's mask stays in place while a scene without fingertips stands still. Fingertips are found
     // again in every pair: a finger that moves less than the comparison sees (a pixel or two, within its
     // blocks' noise) still moves the region its height is read on, and a tip kept in place read false
@@ -128,7 +138,7 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
                        segmenter_.judgedRegion());
         stillScene_.adoptAsReference();
     }
-    measureFingertips(pair, settings);
+    measureFingertips(ordered, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);
     return result_;

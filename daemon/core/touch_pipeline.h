@@ -14,6 +14,7 @@
 #include "core/fingertips.h"
 #include "core/frame.h"
 #include "core/hand_segmentation.h"
+#include "core/polarity_lock.h"
 #include "core/still_scene.h"
 #include "core/surface_height.h"
 
@@ -76,6 +77,12 @@ struct PipelineResult {
     // The scene, with no fingertip in it, matched the last segmented pair within the camera's noise
     // (core/still_scene.h): the mask is that pair's. Tracking ran on this pair.
     bool sceneStill = false;
+    // The pair's frames were taken the other way round than they came labelled: the code's sign says which
+    // shows O + P (core/polarity_lock.h). S, the height and everything after follow that order.
+    bool framesSwapped = false;
+    // How often that order has changed since the pipeline started: a camera that started on an O - P frame,
+    // a refresh the projector missed.
+    std::uint64_t polaritySwaps = 0;
     std::vector<FingertipObservation> fingertips;
     Contacts contacts;  // tracked, in display pixels
 };
@@ -113,6 +120,7 @@ private:
 
     DetectionOptions options_;
     HandSegmenter segmenter_;
+    PolarityLock polarityLock_;
     StillScene stillScene_;
     SurfaceHeight height_;
     ContactTracker tracker_;

@@ -23,7 +23,7 @@ std::uint64_t framesMissedBetween(std::uint64_t last, std::uint64_t next);
 // is copied once out of the stream's buffer, which goes straight back to the stream. Buffers the camera or
 // the link did not complete, and frames missing from the camera's frame counter, are counted as dropped and
 // never delivered. Frames carry the camera's timestamps and alternate in polarity by their place in the
-// camera's count.
+// camera's count; which of them really shows O + P, detection reads from the code (core/polarity_lock.h).
 class AravisSource final : public FrameSource {
 public:
     // `id` as arv-tool-0.8 lists it, or a GigE camera's address; empty: the first camera found. Throws

@@ -565,6 +565,10 @@ void Daemon::shutDown() {
                  << " ms (99th percentile)"
                  << (statistics.pipelineFailures
                          ? ", failed on " + std::to_string(statistics.pipelineFailures) + " pairs"
+                         : std::string())
+                 << (statistics.polaritySwaps
+                         ? "; the frames' order was swapped " + std::to_string(statistics.polaritySwaps) +
+                               " times by the code's sign"
                          : std::string());
     snapshots_.reset();
     loop_.reset();

@@ -264,6 +264,16 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
         notify_();
     }
     recordPipelineTime(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    if (result->polaritySwaps != polaritySwaps_) {
+        polaritySwaps_ = result->polaritySwaps;
+        {
+            std::lock_guard lock(mutex_);
+            statistics_.polaritySwaps = polaritySwaps_;
+        }
+        ET_LOG(Notice) << "from frame " << pair.latest().index << " the camera's frames are taken the "
+                       << (result->framesSwapped ? "other way round: " : "way they are labelled again: ")
+                       << "the code's sign says which shows O + P";
+    }
     const bool changed = detecting_ != result->detecting;
     if (changed || !result->detecting) {
         std::lock_guard lock(mutex_);

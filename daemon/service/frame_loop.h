@@ -36,6 +36,9 @@ struct LoopStatistics {
     double pipelineMedianMs = 0.0;
     double pipelineP99Ms = 0.0;
     std::uint64_t pipelineFailures = 0;  // pairs on which a stage failed; their contacts were released
+    // How often the code's sign swapped the order in which the camera's frames are taken (a camera that
+    // started on the O - P frame, a refresh the projector missed; core/polarity_lock.h).
+    std::uint64_t polaritySwaps = 0;
 };
 
 struct LoopOptions {
@@ -116,7 +119,9 @@ private:
     std::atomic<bool> stopping_{false};
     std::atomic<bool> finished_{false};
     std::atomic<bool> detecting_{false};
-    std::atomic<bool> failingNow_{false};  // the last pair failed; its failure has been logged once
+    std::atomic<bool> failingNow_{false};
+    std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)  // the last
+                                       // pair failed; its failure has been logged once
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
     std::thread pipelineThread_;

@@ -1,4 +1,9 @@
 // Runs the real everytouchd and everytouch-calib binaries.
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -96,6 +101,53 @@ TEST(Everytouchd, RecordsTheSimulatedRigWithGroundTruth) {
     ASSERT_TRUE(recording.hasMasks());  // and so a mask file for every frame, masks/000360.png on
     EXPECT_TRUE(std::filesystem::is_regular_file(dir / "rec" / "masks" / "000383.png"));
     EXPECT_GT(cv::countNonZero(recording.loadMask(23)), 0) << "the pointing hand";
+}
+
+TEST(Everytouchd, FramesLabelledTheOtherWayRoundGiveTheSameTouches) {
+    // A camera that starts on the O - P frame labels every frame with the wrong polarity: the code's sign
+    // tells, and the touches come out as from the frames labelled right.
+    test::TempDir dir;
+    const test::ProcessResult recorded =
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "sim:grid35,start=1.6", "--fast", "--frames", "40",
+                          "--record", (dir / "right").string()});
+    ASSERT_EQ(recorded.exitCode, 0) << recorded.err;
+    std::filesystem::copy(dir / "right", dir / "wrong", std::filesystem::copy_options::recursive);
+    {
+        std::ifstream in(dir / "right" / "frames.csv");
+        std::ofstream out(dir / "wrong" / "frames.csv", std::ios::trunc);
+        std::string line;
+        std::getline(in, line);
+        out << line << '\n';
+        while (std::getline(in, line)) {
+            const std::size_t comma = line.rfind(',');
+            out << line.substr(0, comma + 1) << (line.substr(comma + 1) == "1" ? "-1" : "1") << '\n';
+        }
+    }
+    std::vector<std::vector<io::TouchLogEntry>> logs;
+    for (const char* name : {"right", "wrong"}) {
+        const std::filesystem::path log = dir / (std::string(name) + ".jsonl");
+        const test::ProcessResult replayed = test::runProcess(
+            {EVERYTOUCHD_PATH, "--rig", "replay:" + (dir / name).string(), "--fast", "--log", log.string()});
+        ASSERT_EQ(replayed.exitCode, 0) << replayed.err;
+        if (std::string(name) == "wrong")
+            EXPECT_THAT(replayed.err, HasSubstr("taken the other way round"));
+        else
+            EXPECT_THAT(replayed.err, ::testing::Not(HasSubstr("other way round")));
+        logs.push_back(io::readTouchLog(log));
+    }
+    const auto touching = [](const std::vector<io::TouchLogEntry>& log) {
+        int n = 0;
+        for (const io::TouchLogEntry& entry : log)
+            for (const core::Contact& contact : entry.contacts)
+                n += contact.touching;
+        return n;
+    };
+    ASSERT_GT(touching(logs[0]), 10) << "the finger touches from frame 205";
+    ASSERT_EQ(logs[1].size(), logs[0].size());
+    for (std::size_t i = 0; i < logs[0].size(); ++i) {
+        EXPECT_EQ(logs[1][i].index, logs[0][i].index);
+        EXPECT_EQ(logs[1][i].contacts, logs[0][i].contacts) << "frame " << logs[0][i].index;
+    }
 }
 
 TEST(Everytouchd, BadSimulatorOptionIsAUsageError) {

@@ -13,6 +13,7 @@
 #include "core/code_image.h"
 #include "core/fingertips.h"
 #include "core/hand_segmentation.h"
+#include "core/polarity_lock.h"
 #include "core/surface_height.h"
 #include "core/touch_pipeline.h"
 #include "sim/simulator.h"
@@ -171,6 +172,21 @@ void BM_HeightOfOneFingertip(benchmark::State& state) {
     timings.report(state);
 }
 BENCHMARK(BM_HeightOfOneFingertip)->Unit(benchmark::kMicrosecond);
+
+// The check of the frames' order on every pair: S correlated with the table's code along sampled rows.
+void BM_PolarityCheck(benchmark::State& state) {
+    const Scene& scene = oneHand();
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::PolarityLock lock;
+    lock.setRig(segmenter.tableCode(), segmenter.judgedRegion());
+    cv::Mat subtraction, texture;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    for (auto _ : state)
+        benchmark::DoNotOptimize(lock.relock(subtraction));
+    state.counters["correlation"] = lock.correlation();
+}
+BENCHMARK(BM_PolarityCheck)->Unit(benchmark::kMicrosecond);
 
 void runPipeline(benchmark::State& state, const Scene& scene) {
     cv::setNumThreads(1);
