@@ -260,13 +260,13 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     fill(colourKnown_, 0);
     growIntoFaintBlocks(texture);
     growOverTouchingSkin(texture);
+    findHandBox();
     labelPixels(texture, subtraction, mask);
 
-    cv::Rect handBlocks;
-    for (int by = 0; by < blockClass_.rows; ++by)
-        for (int bx = 0; bx < blockClass_.cols; ++bx)
-            if (isHand(blockClass_.at<uchar>(by, bx)))
-                handBlocks |= cv::Rect(bx - 1, by - 1, 3, 3);  // with the outline's blocks around it
+    // The hand's blocks with the outline's blocks around them.
+    const cv::Rect handBlocks =
+        handBox_.empty() ? cv::Rect()
+                         : cv::Rect(handBox_.x - 1, handBox_.y - 1, handBox_.width + 2, handBox_.height + 2);
     const int blockPx = options_.blockPx;
     const int radius =
         static_cast<int>(std::lround(0.5 * options_.smoothingWidths * options_.fingerWidthMm * pixelsPerMm_));
@@ -589,23 +589,40 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
     }
 }
 
+void HandSegmenter::findHandBox() {
+    int top = blockClass_.rows, bottom = -1, left = blockClass_.cols, right = -1;
+    for (int by = 0; by < blockClass_.rows; ++by) {
+        const uchar* classes = blockClass_.ptr<uchar>(by);
+        for (int bx = 0; bx < blockClass_.cols; ++bx)
+            if (isHand(classes[bx])) {
+                top = std::min(top, by);
+                bottom = by;
+                left = std::min(left, bx);
+                right = std::max(right, bx);
+            }
+    }
+    handBox_ = bottom < 0 ? cv::Rect() : cv::Rect(left, top, right - left + 1, bottom - top + 1);
+}
+
 void HandSegmenter::measureDepthInHand() {
-    // The chessboard distance transform in two passes; beyond the grid lies no hand.
+    // The chessboard distance transform in two passes over the hand's box; beyond it lies no hand.
+    const cv::Rect& handBox = handBox_;
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     depthInHand_.create(blockClass_.size(), CV_8UC1);
+    fill(depthInHand_, 0);
     const auto depthAt = [&](int y, int x) {
         return y < 0 || x < 0 || y >= rows || x >= cols ? 0 : int{depthInHand_.at<uchar>(y, x)};
     };
-    for (int y = 0; y < rows; ++y)
-        for (int x = 0; x < cols; ++x) {
+    for (int y = handBox.y; y < handBox.y + handBox.height; ++y)
+        for (int x = handBox.x; x < handBox.x + handBox.width; ++x) {
             int depth = 0;
             if (isHand(blockClass_.at<uchar>(y, x)))
                 depth = 1 + std::min({depthAt(y, x - 1), depthAt(y - 1, x - 1), depthAt(y - 1, x),
                                       depthAt(y - 1, x + 1)});
             depthInHand_.at<uchar>(y, x) = static_cast<uchar>(std::min(depth, 255));
         }
-    for (int y = rows - 1; y >= 0; --y)
-        for (int x = cols - 1; x >= 0; --x) {
+    for (int y = handBox.y + handBox.height - 1; y >= handBox.y; --y)
+        for (int x = handBox.x + handBox.width - 1; x >= handBox.x; --x) {
             const int depth =
                 std::min({int{depthInHand_.at<uchar>(y, x)}, 1 + depthAt(y, x + 1), 1 + depthAt(y + 1, x + 1),
                           1 + depthAt(y + 1, x), 1 + depthAt(y + 1, x - 1)});
@@ -624,14 +641,15 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
     // or no code. A window reaching over the outline makes blocks up to a window's half beyond it look like
     // hand, so a clean sample of skin lies that far inside the region of hand blocks.
     const int depth = options_.windowBlocks / 2 + 1;
-    measureDepthInHand();
-    const auto pure = [&](int y, int x) { return depthInHand_.at<uchar>(y, x) > depth; };
     constexpr int kLitReach = 1;  // the lit test averages S over 3 x 3 pixels
     const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
     const int litSum = static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));
     litPatch_.resize(static_cast<std::size_t>((blockPx + 2 * kLitReach) * (blockPx + 2 * kLitReach)));
-    for (int by = 0; by < rows; ++by)
-        for (int bx = 0; bx < cols; ++bx) {
+    measureDepthInHand();
+    const auto pure = [&](int y, int x) { return depthInHand_.at<uchar>(y, x) > depth; };
+    // Only the blocks next to the hand's are looked at.
+    for (int by = std::max(handBox_.y - 1, 0); by <= std::min(handBox_.br().y, rows - 1); ++by)
+        for (int bx = std::max(handBox_.x - 1, 0); bx <= std::min(handBox_.br().x, cols - 1); ++bx) {
             const uchar c = blockClass_.at<uchar>(by, bx);
             if (c == Outside)
                 continue;

@@ -106,8 +106,10 @@ private:
     const float* blockFeature(const cv::Mat& texture, int by, int bx);
     void growIntoFaintBlocks(const cv::Mat& texture);
     void growOverTouchingSkin(const cv::Mat& texture);
+    // handBox_ receives the box of the hand's blocks (empty without any).
+    void findHandBox();
     // depthInHand_ receives each block's chessboard distance to the nearest block that is not hand (0 on
-    // those, 1 on the hand's outline blocks).
+    // those, 1 on the hand's outline blocks), over handBox_.
     void measureDepthInHand();
     void labelPixels(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
 
@@ -125,6 +127,7 @@ private:
     cv::Mat blockClass_;         // CV_8UC1, block grid
     cv::Mat blockColour_;        // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
     cv::Mat colourKnown_;        // CV_8UC1, block grid: 1 where the colour has been measured this frame
+    cv::Rect handBox_;           // block grid: the box of the hand's blocks (findHandBox)
     cv::Mat depthInHand_;        // CV_8UC1, block grid (measureDepthInHand)
     std::vector<int> litPatch_;  // S around one block, as labelPixels' lit test counts it
     std::vector<float> values_;
