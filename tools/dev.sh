@@ -3,6 +3,7 @@
 #   tools/dev.sh run [everytouchd options]   install what is missing, build, run the daemon on the simulated rig
 #   tools/dev.sh test                          install what is missing, build, run the whole test suite
 #   tools/dev.sh sanitize                      the test suite again, built with AddressSanitizer + UBSan
+#   tools/dev.sh fuzz [SECONDS [TARGET...]]    fuzz each reader of outside input with libFuzzer (docs/fuzzing.md)
 #   tools/dev.sh format                        apply clang-format to every C++ file (format-check: only report)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -88,6 +89,28 @@ sanitize)
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
         ctest --test-dir build-sanitize --output-on-failure -j "$jobs" \
         -E '^(ServiceTest\.(ProjectorCalibrationOnTheSimulatedRig|ANewUserCalibratesFully)|Fingertips\.FindTheSimulatedFingersAndTheirPads|HandSegmentation\.(TouchingFingertipsKeepTheirEnds|AFingerSlidingFlatOnTheTableKeepsItsWidth|AFingerPassingHighIsFoundInEveryPair)|SurfaceHeightRendered\.ASlidingFingertipsHeightIsReadAndKeepsToItsSurface|TouchPipelineRendered\.(ADragStaysOneTouch|OnlyAStillSceneKeepsItsMask)|EvaluateTouches\.ScoresTheSimulatedRigLiveAsItsRecording|SystemFiles\.(TheUnitVerifies|TheUnitStaysHardened|EveryFileIsInstalledWhereTheSystemLooksForItWhateverThePrefix|TheDebianPackageHoldsTheInstallAndLintianFindsNoError|TheManualPagesHaveNoMandocWarning))' "$@"
+    ;;
+fuzz)
+    # clang only for this command: the test suite replays the corpora in every build without it.
+    packages+=(clang)
+    install_missing_packages
+    seconds=${1:-600}
+    [ $# -gt 0 ] && shift
+    targets=("$@")
+    [ ${#targets[@]} -gt 0 ] || targets=($(sed -n 's/^set(fuzz_targets \(.*\))$/\1/p' tests/fuzz/CMakeLists.txt))
+    CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEVERYTOUCH_FUZZ=ON \
+        -DEVERYTOUCH_BUILD_BENCHMARKS=OFF -DEVERYTOUCH_BUILD_DEVELOPER_TOOLS=OFF -DCMAKE_UNITY_BUILD=ON \
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" >/dev/null
+    cmake --build build-fuzz -j "$jobs" --target "${targets[@]/#/fuzz_}"
+    for target in "${targets[@]}"; do
+        # New inputs go to build-fuzz/corpus/TARGET, findings to build-fuzz/findings/TARGET; the seeds in
+        # tests/fuzz/corpus/TARGET are read, never written.
+        mkdir -p "build-fuzz/corpus/$target" "build-fuzz/findings/$target"
+        echo "fuzzing $target for $seconds s"
+        "build-fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 \
+            -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$target/" \
+            "build-fuzz/corpus/$target" "tests/fuzz/corpus/$target"
+    done
     ;;
 format)
     cpp_files | xargs clang-format -i

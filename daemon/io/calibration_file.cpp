@@ -1,6 +1,10 @@
 #include "io/calibration_file.h"
 
 #include <cmath>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <string_view>
 
 #include <opencv2/core/eigen.hpp>
 
@@ -32,6 +36,21 @@ cv::Size readSize(const cv::FileNode& root, const std::string& inputName, const 
 cv::Mat readMatrix(const cv::FileNode& root, const std::string& inputName, const char* key, int rows,
                    int cols) {
     const cv::FileNode node = requireKey(root, inputName, key);
+    // OpenCV allocates the rows and columns a matrix node claims before it reads its data: a file that
+    // claims billions of them would exhaust the memory. Only a node that holds as many numbers as it claims,
+    // and no more than a calibration needs, reaches it.
+    constexpr int kLargestSide = 16;
+    const cv::FileNode claimedRows = node.isMap() ? node["rows"] : cv::FileNode();
+    const cv::FileNode claimedCols = node.isMap() ? node["cols"] : cv::FileNode();
+    const cv::FileNode data = node.isMap() ? node["data"] : cv::FileNode();
+    if (!claimedRows.isInt() || !claimedCols.isInt() || !data.isSeq() || static_cast<int>(claimedRows) < 1 ||
+        static_cast<int>(claimedRows) > kLargestSide || static_cast<int>(claimedCols) < 1 ||
+        static_cast<int>(claimedCols) > kLargestSide ||
+        data.size() !=
+            static_cast<std::size_t>(static_cast<int>(claimedRows) * static_cast<int>(claimedCols)))
+        throw InputError(inputName, key,
+                         "expected an opencv-matrix of at most " + std::to_string(kLargestSide) + "x" +
+                             std::to_string(kLargestSide) + " numbers, rows x cols of them");
     cv::Mat matrix;
     try {
         node >> matrix;
@@ -75,15 +94,79 @@ void writeSize(cv::FileStorage& storage, const char* key, const cv::Size& size) 
     storage << key << "[:" << size.width << size.height << "]";
 }
 
+// What OpenCV 4.6's YAML parser cannot survive, found by fuzzing (tests/fuzz): a mapping key that is empty
+// (a colon with nothing but blanks since the line's start, a "{" or a ","; outside quotes and comments) ends
+// the process, and text after a document marker "---" on its line can make it loop for ever. Says where.
+std::optional<std::string> findUnparsable(std::string_view text) {
+    for (std::size_t start = 0, line = 1; start < text.size(); ++line) {
+        const std::size_t end = std::min(text.find('\n', start), text.size());
+        const std::string_view content = text.substr(start, end - start);
+        if (content.substr(0, 3) == "---" && content.find_first_not_of(" \t\r", 3) != std::string_view::npos)
+            return "line " + std::to_string(line) + ": something after the document marker ---";
+        start = end + 1;
+    }
+    int line = 1;
+    char previous = '\n';         // the character before this one on its line
+    char lastSignificant = '\n';  // the last one that was not a blank
+    char quote = 0;
+    bool comment = false;
+    const auto startsValue = [](char c) {
+        return std::string_view("\n:[{,-").find(c) != std::string_view::npos;
+    };
+    for (const char c : text) {
+        if (c == '\n') {
+            ++line;
+            comment = false;
+            quote = 0;
+            previous = lastSignificant = '\n';
+            continue;
+        }
+        const char before = previous;
+        previous = c;
+        if (comment)
+            continue;
+        if (quote) {
+            if (c == quote)
+                quote = 0;
+            continue;
+        }
+        if ((c == '"' || c == '\'') && startsValue(lastSignificant)) {
+            quote = c;  // a quoted scalar; a quote inside a plain one is just a character
+        } else if (c == '#' && (before == '\n' || before == ' ' || before == '\t')) {
+            comment = true;  // comments begin at the line's start or after a blank
+            continue;
+        } else if (c == ':' &&
+                   (lastSignificant == '\n' || lastSignificant == '{' || lastSignificant == ',')) {
+            return "line " + std::to_string(line) + ": a key without a name";
+        }
+        if (c != ' ' && c != '\t' && c != '\r')
+            lastSignificant = c;
+    }
+    return std::nullopt;
+}
+
 }  // namespace
 
 cv::FileStorage openYamlForReading(const std::filesystem::path& path) {
     std::error_code error;
     if (!std::filesystem::is_regular_file(path, error))
         throw InputError(path.string(), "", "no such file");
+    // The text is read here and checked before OpenCV's parser sees it (findUnparsable).
+    std::ifstream in(path, std::ios::binary);
+    std::string text;
+    constexpr std::size_t kLargestFile = 1 << 20;
+    text.resize(kLargestFile + 1);
+    in.read(text.data(), static_cast<std::streamsize>(text.size()));
+    if (in.bad())
+        throw InputError(path.string(), "", "cannot be read");
+    text.resize(static_cast<std::size_t>(in.gcount()));
+    if (text.size() > kLargestFile)
+        throw InputError(path.string(), "", "larger than any calibration (1 MiB)");
+    if (const std::optional<std::string> problem = findUnparsable(text))
+        throw InputError(path.string(), "", "not a valid YAML document (" + *problem + ")");
     cv::FileStorage storage;
     try {
-        storage.open(path.string(), cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML);
+        storage.open(text, cv::FileStorage::READ | cv::FileStorage::FORMAT_YAML | cv::FileStorage::MEMORY);
     } catch (const cv::Exception& e) {
         throw InputError(path.string(), "", "not a valid YAML document (" + e.err + ")");
     }

@@ -112,6 +112,32 @@ TEST_F(CalibrationFileTest, RejectsGarbageAndMissingFile) {
                 ::testing::ThrowsMessage<InputError>(HasSubstr("nowhere.yml")));
 }
 
+TEST_F(CalibrationFileTest, RejectsAMatrixThatClaimsMoreThanItHolds) {
+    // OpenCV would allocate what rows and cols claim before reading the data (found by fuzzing).
+    EXPECT_THAT(
+        complaintAfter("(camera_matrix: !!opencv-matrix\\s+rows: )3(\\s+cols: )3", "$011000000$021000000"),
+        AllOf(HasSubstr("bad.yml"), HasSubstr("camera_matrix"), HasSubstr("opencv-matrix")));
+    // Fewer numbers than rows x cols.
+    EXPECT_THAT(complaintAfter("(camera_matrix: !!opencv-matrix\\s+rows: )3", "$014"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("camera_matrix")));
+}
+
+TEST_F(CalibrationFileTest, RejectsAnEmptyKeyBeforeOpenCVSeesIt) {
+    // OpenCV 4.6 ends the whole process on these (found by fuzzing): they must be an error like any other.
+    EXPECT_THAT(complaintAfter("camera_size: \\[ 648, 488 \\]", "camera_size: { : 648 }"),
+                AllOf(HasSubstr("bad.yml"), HasSubstr("line 5"), HasSubstr("key without a name")));
+    test::writeText(badPath_, "%YAML:1.0\n---\na: 0\n   :\n");
+    EXPECT_THAT([&] { readCalibrationFile(badPath_); },
+                ::testing::ThrowsMessage<InputError>(AllOf(HasSubstr("bad.yml"), HasSubstr("line 4"))));
+}
+
+TEST_F(CalibrationFileTest, RejectsTextAfterTheDocumentMarker) {
+    // OpenCV 4.6 loops for ever on this one (found by fuzzing).
+    test::writeText(badPath_, "%YAML:1.0\n---a: 0\n~---\nt");
+    EXPECT_THAT([&] { readCalibrationFile(badPath_); },
+                ::testing::ThrowsMessage<InputError>(AllOf(HasSubstr("bad.yml"), HasSubstr("line 2"))));
+}
+
 TEST_F(CalibrationFileTest, FailedWriteLeavesTheOldFileIntact) {
     core::Calibration broken = test::paperLikeCalibration();
     broken.cameraMatrix(1, 1) = 0;
