@@ -96,14 +96,26 @@ void writeSize(cv::FileStorage& storage, const char* key, const cv::Size& size) 
 
 // What OpenCV 4.6's YAML parser cannot survive, found by fuzzing (tests/fuzz): a mapping key that is empty
 // (a colon with nothing but blanks since the line's start, a "{" or a ","; outside quotes and comments) ends
-// the process, and text after a document marker "---" on its line can make it loop for ever. Says where.
+// the process; text after a document marker "---" on its line, or a document whose first key is indented,
+// can make it loop for ever. Says where.
 std::optional<std::string> findUnparsable(std::string_view text) {
+    bool keyFound = false;
     for (std::size_t start = 0, line = 1; start < text.size(); ++line) {
         const std::size_t end = std::min(text.find('\n', start), text.size());
-        const std::string_view content = text.substr(start, end - start);
+        const std::string_view whole = text.substr(start, end - start);
+        const std::size_t indent = std::min(whole.find_first_not_of(" \t\r"), whole.size());
+        const std::string_view content = whole.substr(indent);
+        start = end + 1;
         if (content.substr(0, 3) == "---" && content.find_first_not_of(" \t\r", 3) != std::string_view::npos)
             return "line " + std::to_string(line) + ": something after the document marker ---";
-        start = end + 1;
+        if (content.empty() || content.front() == '#' || content.front() == '%' ||
+            content.substr(0, 3) == "---")
+            continue;
+        // The document's own keys start at the line's beginning; an indented first one can make the parser
+        // loop for ever when a line further down is less indented.
+        if (!keyFound && indent > 0)
+            return "line " + std::to_string(line) + ": the document's first key is indented";
+        keyFound = true;
     }
     int line = 1;
     char previous = '\n';         // the character before this one on its line

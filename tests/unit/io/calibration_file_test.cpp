@@ -138,6 +138,13 @@ TEST_F(CalibrationFileTest, RejectsTextAfterTheDocumentMarker) {
                 ::testing::ThrowsMessage<InputError>(AllOf(HasSubstr("bad.yml"), HasSubstr("line 2"))));
 }
 
+TEST_F(CalibrationFileTest, RejectsAnIndentedFirstKey) {
+    // And on this one (found by fuzzing): the document's keys start at the line's beginning.
+    test::writeText(badPath_, "%YAML:1.0\n---\n a: xd-\na_--\n");
+    EXPECT_THAT([&] { readCalibrationFile(badPath_); },
+                ::testing::ThrowsMessage<InputError>(AllOf(HasSubstr("bad.yml"), HasSubstr("line 3"))));
+}
+
 TEST_F(CalibrationFileTest, FailedWriteLeavesTheOldFileIntact) {
     core::Calibration broken = test::paperLikeCalibration();
     broken.cameraMatrix(1, 1) = 0;
