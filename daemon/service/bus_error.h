@@ -1,7 +1,10 @@
 #pragma once
 
+#include <cstring>
 #include <stdexcept>
 #include <string>
+
+#include <systemd/sd-bus.h>
 
 namespace everytouch::service {
 
@@ -14,5 +17,12 @@ public:
 private:
     const char* name_;
 };
+
+// For sd-bus calls that read a client's message: a failure (negative errno) means the message does not hold
+// what it should, and `what` names the part.
+inline void checkBusCall(int r, const char* what) {
+    if (r < 0)
+        throw BusError(SD_BUS_ERROR_INVALID_ARGS, std::string(what) + ": " + std::strerror(-r));
+}
 
 }  // namespace everytouch::service

@@ -5,7 +5,9 @@
 #include <exception>
 
 #include "io/log.h"
+#include "service/bus_error.h"
 #include "service/bus_names.h"
+#include "service/calibrate_options.h"
 #include "service/daemon.h"
 
 namespace everytouch::service {
@@ -29,55 +31,6 @@ int guarded(sd_bus_error* error, Body&& body) noexcept {
     } catch (...) {
         return sd_bus_error_set(error, SD_BUS_ERROR_FAILED, "internal error");
     }
-}
-
-void check(int r, const char* what) {
-    if (r < 0)
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS, std::string(what) + ": " + std::strerror(-r));
-}
-
-template <typename T>
-T readOption(sd_bus_message* message, const char* key, const char* type) {
-    const char* contents = nullptr;
-    check(sd_bus_message_peek_type(message, nullptr, &contents), "Calibrate options");
-    if (!contents || std::strcmp(contents, type) != 0)
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS, std::string("Calibrate option \"") + key +
-                                                      "\" must be of type " + type + ", not " +
-                                                      (contents ? contents : "?"));
-    T value{};
-    check(sd_bus_message_read(message, "v", type, &value), "Calibrate options");
-    return value;
-}
-
-CalibrationOptions readCalibrationOptions(sd_bus_message* message) {
-    CalibrationOptions options;
-    check(sd_bus_message_enter_container(message, 'a', "{sv}"), "Calibrate options");
-    int r = 0;
-    while ((r = sd_bus_message_enter_container(message, 'e', "sv")) > 0) {
-        const char* key = nullptr;
-        check(sd_bus_message_read(message, "s", &key), "Calibrate options");
-        if (std::strcmp(key, bus::kOptionFrames) == 0)
-            options.pairsPerStep = readOption<std::uint32_t>(message, key, "u");
-        else if (std::strcmp(key, bus::kOptionCardWidthMm) == 0)
-            options.cardWidthMm = readOption<double>(message, key, "d");
-        else if (std::strcmp(key, bus::kOptionCardHeightMm) == 0)
-            options.cardHeightMm = readOption<double>(message, key, "d");
-        else if (std::strcmp(key, bus::kOptionViews) == 0)
-            options.views = readOption<std::uint32_t>(message, key, "u");
-        else if (std::strcmp(key, bus::kOptionViewTimeoutS) == 0)
-            options.viewTimeoutS = readOption<double>(message, key, "d");
-        else
-            throw BusError(SD_BUS_ERROR_INVALID_ARGS,
-                           std::string("Unknown Calibrate option \"") + key +
-                               "\"; known: frames (u), card_width_mm (d), card_height_mm (d), views (u), "
-                               "view_timeout_s (d)");
-        check(sd_bus_message_exit_container(message), "Calibrate options");
-    }
-    check(r, "Calibrate options");
-    check(sd_bus_message_exit_container(message), "Calibrate options");
-    if (auto problem = options.validate())
-        throw BusError(SD_BUS_ERROR_INVALID_ARGS, "Calibrate option " + *problem);
-    return options;
 }
 
 int getApiVersion(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void*,
@@ -155,7 +108,7 @@ int setTouchHeightMm(sd_bus* bus, const char*, const char*, const char*, sd_bus_
         BusService& service = serviceOf(userdata);
         service.requirePrivileged(sd_bus_get_current_message(bus), "Setting TouchHeightMm");
         double heightMm = 0.0;
-        check(sd_bus_message_read(value, "d", &heightMm), bus::kPropertyTouchHeightMm);
+        checkBusCall(sd_bus_message_read(value, "d", &heightMm), bus::kPropertyTouchHeightMm);
         service.daemon().setTouchHeightMm(heightMm);
         return 0;
     });
@@ -171,7 +124,7 @@ int methodCalibrate(sd_bus_message* message, void* userdata, sd_bus_error* error
         BusService& service = serviceOf(userdata);
         service.requirePrivileged(message, "Calibrating");
         const char* step = nullptr;
-        check(sd_bus_message_read(message, "s", &step), "Calibrate step");
+        checkBusCall(sd_bus_message_read(message, "s", &step), "Calibrate step");
         const CalibrationOptions options = readCalibrationOptions(message);
         service.daemon().calibrate(step, options);
         return sd_bus_reply_method_return(message, nullptr);
@@ -212,7 +165,7 @@ int methodSnapshot(sd_bus_message* message, void* userdata, sd_bus_error* error)
         service.requirePrivileged(message, "Taking a snapshot");
         const char* what = nullptr;
         int fd = -1;
-        check(sd_bus_message_read(message, "sh", &what, &fd), "Snapshot arguments");
+        checkBusCall(sd_bus_message_read(message, "sh", &what, &fd), "Snapshot arguments");
         service.daemon().snapshot(message, what, fd);
         return 1;  // the reply follows once a frame pair has been written
     });
