@@ -25,19 +25,26 @@ constexpr std::uint64_t kTouchTo = 240;
 struct Rendered {
     sim::SimParameters parameters;
     std::optional<sim::Simulator> simulator;
-    std::vector<Frame> frames;  // kFirst .. kEnd - 1, labelled as the simulated projector showed them
+    std::vector<Frame> frames;  // from kFirst, labelled as the simulated projector showed them
 };
 
+Rendered render(std::uint64_t end) {
+    Rendered r;
+    r.parameters.scenario = "grid35";
+    r.simulator.emplace(r.parameters, sim::rigPattern(r.parameters));
+    sim::FrameTruth truth;
+    for (std::uint64_t index = kFirst; index < end; ++index)
+        r.simulator->render(index, r.frames.emplace_back(), truth);
+    return r;
+}
+
+// The whole stretch, for the pipeline; its first three frames, for the lock alone.
 const Rendered& rendered() {
-    static const Rendered scene = [] {
-        Rendered r;
-        r.parameters.scenario = "grid35";
-        r.simulator.emplace(r.parameters, sim::rigPattern(r.parameters));
-        sim::FrameTruth truth;
-        for (std::uint64_t index = kFirst; index < kEnd; ++index)
-            r.simulator->render(index, r.frames.emplace_back(), truth);
-        return r;
-    }();
+    static const Rendered scene = render(kEnd);
+    return scene;
+}
+const Rendered& firstFrames() {
+    static const Rendered scene = render(kFirst + 3);
     return scene;
 }
 
@@ -48,7 +55,7 @@ FramePair pairOf(const Frame& older, const Frame& newer) {
 class PolarityLockTest : public ::testing::Test {
 protected:
     void SetUp() override {
-        const sim::Simulator& simulator = *rendered().simulator;
+        const sim::Simulator& simulator = *firstFrames().simulator;
         segmenter.setRig(simulator.calibration(), simulator.pattern());
         lock.setRig(segmenter.tableCode(), segmenter.judgedRegion());
     }
@@ -62,7 +69,7 @@ protected:
 };
 
 TEST_F(PolarityLockTest, KeepsTheOrderTheCodeConfirms) {
-    const std::vector<Frame>& frames = rendered().frames;
+    const std::vector<Frame>& frames = firstFrames().frames;
     EXPECT_FALSE(relock(pairOf(frames[0], frames[1])));
     EXPECT_FALSE(lock.swapped());
     EXPECT_GT(lock.correlation(), PolarityLock::kSignificance * lock.chance());
@@ -71,7 +78,7 @@ TEST_F(PolarityLockTest, KeepsTheOrderTheCodeConfirms) {
 }
 
 TEST_F(PolarityLockTest, SwapsAPairMadeTheWrongWayRound) {
-    const std::vector<Frame>& frames = rendered().frames;
+    const std::vector<Frame>& frames = firstFrames().frames;
     const FramePair wrong = swappedPair(pairOf(frames[0], frames[1]));
     EXPECT_TRUE(relock(wrong));
     EXPECT_TRUE(lock.swapped());
@@ -83,7 +90,7 @@ TEST_F(PolarityLockTest, SwapsAPairMadeTheWrongWayRound) {
 }
 
 TEST_F(PolarityLockTest, APairWithoutCodeChangesNothing) {
-    const std::vector<Frame>& frames = rendered().frames;
+    const std::vector<Frame>& frames = firstFrames().frames;
     // Two frames of the same polarity (a refresh the projector repeated): the code cancels.
     EXPECT_FALSE(relock(FramePair{frames[2], frames[0]}));
     EXPECT_LT(std::abs(lock.correlation()), PolarityLock::kSignificance * lock.chance());
