@@ -641,6 +641,8 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
     // or no code. A window reaching over the outline makes blocks up to a window's half beyond it look like
     // hand, so a clean sample of skin lies that far inside the region of hand blocks.
     const int depth = options_.windowBlocks / 2 + 1;
+    if (handBox_.empty())
+        return;
     constexpr int kLitReach = 1;  // the lit test averages S over 3 x 3 pixels
     const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
     const int litSum = static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));

@@ -8,6 +8,8 @@
 #include <string_view>
 #include <vector>
 
+#include "io/input_error.h"
+
 namespace everytouch::fuzz {
 
 // A directory of this process's own, removed at exit.
@@ -15,6 +17,18 @@ const std::filesystem::path& scratchDirectory();
 
 // Writes the bytes to `path`, replacing what was there.
 void writeFile(const std::filesystem::path& path, std::string_view bytes);
+
+// Writes the input to a file `name` in the scratch directory and has `read` read it: a reader may refuse it
+// only with io::InputError; any other exception escapes, a finding.
+template <typename Read>
+void readAsFile(const char* name, const std::uint8_t* data, std::size_t size, Read&& read) {
+    const std::filesystem::path path = scratchDirectory() / name;
+    writeFile(path, std::string_view(reinterpret_cast<const char*>(data), size));
+    try {
+        read(path);
+    } catch (const io::InputError&) {
+    }
+}
 
 // The input cut at each NUL byte into at most `parts` pieces (the last keeps any further NULs): a target
 // that reads several files takes one piece for each.
