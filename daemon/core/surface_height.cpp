@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera_model.h"
@@ -11,18 +12,41 @@
 
 namespace everytouch::core {
 
-namespace {
+// Bilinear sampling of a CV_32FC1 image; -1 outside.
+class BilinearSampler {
+public:
+    explicit BilinearSampler(const cv::Mat& image)
+        : data_(image.ptr<float>()),
+          step_(static_cast<std::ptrdiff_t>(image.step1())),
+          lastX_(image.cols - 1),
+          lastY_(image.rows - 1) {}
 
-// Bilinear sample of a CV_32FC1 image; 0 outside.
-float sample(const cv::Mat& image, float x, float y) {
-    const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= image.cols || y0 + 1 >= image.rows)
-        return -1.0f;
-    const float fx = x - x0, fy = y - y0;
-    const float* row0 = image.ptr<float>(y0) + x0;
-    const float* row1 = image.ptr<float>(y0 + 1) + x0;
-    return (row0[0] * (1 - fx) + row0[1] * fx) * (1 - fy) + (row1[0] * (1 - fx) + row1[1] * fx) * fy;
-}
+    const float* data() const { return data_; }
+    std::ptrdiff_t step() const { return step_; }
+    int lastX() const { return lastX_; }
+    int lastY() const { return lastY_; }
+
+    float operator()(float x, float y) const {
+        if (!(x >= 0.0f && y >= 0.0f))
+            return -1.0f;
+        const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);  // truncation is the floor here
+        if (x0 >= lastX_ || y0 >= lastY_)
+            return -1.0f;
+        const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+        const float* row0 = data_ + y0 * step_ + x0;
+        const float* row1 = row0 + step_;
+        const float top = row0[0] + (row0[1] - row0[0]) * fx;
+        const float bottom = row1[0] + (row1[1] - row1[0]) * fx;
+        return top + (bottom - top) * fy;
+    }
+
+private:
+    const float* data_;
+    std::ptrdiff_t step_;
+    int lastX_, lastY_;
+};
+
+namespace {
 
 // A pixel of a pair summed over its channels: the frames' difference (Sign -1), which carries the code and
 // what a move leaves, or their sum (Sign +1), twice the texture.
@@ -114,9 +138,6 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     cameraCentre_ = -(cameraToTableRotation * calibration.tableToCamera.translation());
     projectorRotation_ = calibration.projectorMatrix * calibration.tableToProjector.rotation();
     epipole_ = calibration.projectorMatrix * (calibration.tableToProjector * cameraCentre_);
-    sumP_.assign(heightCount_, 0.0);
-    sumPP_.assign(heightCount_, 0.0);
-    sumSP_.assign(heightCount_, 0.0);
 
     // Regions are a fingertip or a sample of a hand: this many pixels at most, in practice.
     constexpr std::size_t kTypicalMostPixels = 8192;
@@ -124,6 +145,7 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     points_.reserve(kTypicalMostPixels);
     gradients_.reserve(kTypicalMostPixels);
     residuals_.reserve(kTypicalMostPixels);
+    rays_.reserve(kTypicalMostPixels);
 
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     undistorted_.create(calibration.cameraSize, CV_32FC2);
@@ -197,30 +219,104 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
         varianceS += r * r;
     evidence.subtractionVariance = varianceS;
     evidence.pixels = static_cast<double>(n);
-    std::fill(sumP_.begin(), sumP_.end(), 0.0);
-    std::fill(sumPP_.begin(), sumPP_.end(), 0.0);
-    std::fill(sumSP_.begin(), sumSP_.end(), 0.0);
+    // Each pixel's ray through the candidate planes, as the projector sees it: a point on the table and a
+    // step per candidate (homogeneous).
+    rays_.clear();
     const double dStep = static_cast<double>(stride) * options_.stepMm;
     for (std::size_t i = 0; i < n; ++i) {
         const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(points_[i].x, points_[i].y, 1.0);
-        if (std::abs(ray.z()) < 1e-12)
-            continue;  // parallel to the table: no pixel of a fingertip
-        const Eigen::Vector3d along = projectorRotation_ * ray / ray.z();
-        Eigen::Vector3d p = epipole_ - cameraCentre_.z() * along;  // on the table
-        const Eigen::Vector3d step = dStep * along;
-        const double residual = residuals_[i];
-        for (std::size_t h = 0; h < heightCount_; h += stride, p += step) {
-            const float value = std::max(
-                0.0f, sample(panel_, static_cast<float>(p.x() / p.z()), static_cast<float>(p.y() / p.z())));
-            sumP_[h] += value;
-            sumPP_[h] += value * value;
-            sumSP_[h] += residual * value;
+        if (std::abs(ray.z()) < 1e-12) {
+            rays_.addOutside();  // parallel to the table: no pixel of a fingertip
+            continue;
         }
+        const Eigen::Vector3d along = projectorRotation_ * ray / ray.z();
+        rays_.add(epipole_ - cameraCentre_.z() * along, dStep * along);
     }
-    for (std::size_t h = 0; h < heightCount_; h += stride) {
-        evidence.covariance[h] = sumSP_[h];
-        evidence.codeVariance[h] = std::max(0.0, sumPP_[h] - sumP_[h] * sumP_[h] / static_cast<double>(n));
+    const BilinearSampler sample(panel_);
+    for (std::size_t h = 0, k = 0; h < heightCount_; h += stride, ++k) {
+        const auto sums = sampleAlongRays(sample, static_cast<float>(k));
+        evidence.covariance[h] = sums.covariance;
+        evidence.codeVariance[h] =
+            std::max(0.0, sums.squares - sums.values * sums.values / static_cast<double>(n));
     }
+}
+
+SurfaceHeight::CodeSums SurfaceHeight::sampleAlongRays(const BilinearSampler& sample, float steps) const {
+    const std::size_t n = residuals_.size();
+    std::size_t i = 0;
+    CodeSums sums;
+#if CV_SIMD128
+    // Four pixels at a time: the positions, their division and the interpolation in vectors, only the
+    // panel's reads one by one.
+    const cv::v_float32x4 k = cv::v_setall_f32(steps), zero = cv::v_setzero_f32();
+    const cv::v_float32x4 lastX = cv::v_setall_f32(static_cast<float>(sample.lastX()));
+    const cv::v_float32x4 lastY = cv::v_setall_f32(static_cast<float>(sample.lastY()));
+    const cv::v_int32x4 rowStep = cv::v_setall_s32(static_cast<int>(sample.step()));
+    cv::v_float32x4 sumValues = zero, sumSquares = zero, sumProducts = zero;
+    alignas(16) int offsets[4];
+    for (; i + 4 <= n; i += 4) {
+        const cv::v_float32x4 inverseZ =
+            cv::v_setall_f32(1.0f) / cv::v_muladd(k, cv::v_load(&rays_.stepZ[i]), cv::v_load(&rays_.z[i]));
+        cv::v_float32x4 x = cv::v_muladd(k, cv::v_load(&rays_.stepX[i]), cv::v_load(&rays_.x[i])) * inverseZ;
+        cv::v_float32x4 y = cv::v_muladd(k, cv::v_load(&rays_.stepY[i]), cv::v_load(&rays_.y[i])) * inverseZ;
+        const cv::v_float32x4 inside = (x >= zero) & (y >= zero) & (x < lastX) & (y < lastY);
+        x = cv::v_select(inside, x, zero);
+        y = cv::v_select(inside, y, zero);
+        const cv::v_int32x4 x0 = cv::v_trunc(x), y0 = cv::v_trunc(y);
+        const cv::v_float32x4 fx = x - cv::v_cvt_f32(x0), fy = y - cv::v_cvt_f32(y0);
+        cv::v_store_aligned(offsets, y0 * rowStep + x0);
+        const float* p0 = sample.data() + offsets[0];
+        const float* p1 = sample.data() + offsets[1];
+        const float* p2 = sample.data() + offsets[2];
+        const float* p3 = sample.data() + offsets[3];
+        const std::ptrdiff_t down = sample.step();
+        const cv::v_float32x4 topLeft(p0[0], p1[0], p2[0], p3[0]), topRight(p0[1], p1[1], p2[1], p3[1]);
+        const cv::v_float32x4 bottomLeft(p0[down], p1[down], p2[down], p3[down]);
+        const cv::v_float32x4 bottomRight(p0[down + 1], p1[down + 1], p2[down + 1], p3[down + 1]);
+        const cv::v_float32x4 top = cv::v_muladd(topRight - topLeft, fx, topLeft);
+        const cv::v_float32x4 bottom = cv::v_muladd(bottomRight - bottomLeft, fx, bottomLeft);
+        const cv::v_float32x4 value =
+            cv::v_select(inside, cv::v_max(zero, cv::v_muladd(bottom - top, fy, top)), zero);
+        sumValues += value;
+        sumSquares = cv::v_muladd(value, value, sumSquares);
+        sumProducts = cv::v_muladd(cv::v_load(&residuals_[i]), value, sumProducts);
+    }
+    sums.values = cv::v_reduce_sum(sumValues);
+    sums.squares = cv::v_reduce_sum(sumSquares);
+    sums.covariance = cv::v_reduce_sum(sumProducts);
+#endif
+    for (; i < n; ++i) {
+        const float inverseZ = 1.0f / (rays_.z[i] + steps * rays_.stepZ[i]);
+        const float value = std::max(0.0f, sample((rays_.x[i] + steps * rays_.stepX[i]) * inverseZ,
+                                                  (rays_.y[i] + steps * rays_.stepY[i]) * inverseZ));
+        sums.values += value;
+        sums.squares += value * value;
+        sums.covariance += residuals_[i] * value;
+    }
+    return sums;
+}
+
+void SurfaceHeight::PanelRays::clear() {
+    for (std::vector<float>* coordinate : {&x, &y, &z, &stepX, &stepY, &stepZ})
+        coordinate->clear();
+}
+
+void SurfaceHeight::PanelRays::reserve(std::size_t pixels) {
+    for (std::vector<float>* coordinate : {&x, &y, &z, &stepX, &stepY, &stepZ})
+        coordinate->reserve(pixels);
+}
+
+void SurfaceHeight::PanelRays::add(const Eigen::Vector3d& onTable, const Eigen::Vector3d& step) {
+    x.push_back(static_cast<float>(onTable.x()));
+    y.push_back(static_cast<float>(onTable.y()));
+    z.push_back(static_cast<float>(onTable.z()));
+    stepX.push_back(static_cast<float>(step.x()));
+    stepY.push_back(static_cast<float>(step.y()));
+    stepZ.push_back(static_cast<float>(step.z()));
+}
+
+void SurfaceHeight::PanelRays::addOutside() {
+    add(Eigen::Vector3d(-1.0, -1.0, 1.0), Eigen::Vector3d::Zero());
 }
 
 void SurfaceHeight::fitResiduals() {

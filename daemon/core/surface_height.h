@@ -72,6 +72,8 @@ struct HeightEstimate {
     double uncertaintyMm = 0.0;  // one standard deviation
 };
 
+class BilinearSampler;
+
 class SurfaceHeight {
 public:
     // Throws std::invalid_argument when options.validate() fails.
@@ -106,9 +108,25 @@ public:
     bool favoursUpTo(const HeightEvidence& evidence, double heightMm) const;
 
 private:
+    // Where the projector sees each pixel's ray: on the table and a step up to the next candidate height
+    // (homogeneous, in projector pixels), one array per coordinate so that pixels are read four at a time.
+    struct PanelRays {
+        std::vector<float> x, y, z, stepX, stepY, stepZ;
+
+        void clear();
+        void reserve(std::size_t pixels);
+        void add(const Eigen::Vector3d& onTable, const Eigen::Vector3d& step);
+        void addOutside();  // a ray that meets no candidate plane: it samples nothing
+    };
+    struct CodeSums {
+        double values = 0.0, squares = 0.0, covariance = 0.0;  // of the predicted code, with the residuals
+    };
+
     void addValue(float value, int x, int y);
     // residuals_: values_ less their mean and, when gradients_ were gathered, what the gradients explain.
     void fitResiduals();
+    // The predicted code at `steps` steps up every ray, summed over the region's pixels.
+    CodeSums sampleAlongRays(const BilinearSampler& sample, float steps) const;
 
     HeightOptions options_;
     cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
@@ -121,11 +139,11 @@ private:
     Eigen::Vector3d cameraCentre_ = Eigen::Vector3d::Zero();
     Eigen::Matrix3d projectorRotation_ = Eigen::Matrix3d::Identity();
     Eigen::Vector3d epipole_ = Eigen::Vector3d::Zero();
-    std::vector<double> sumP_, sumPP_, sumSP_;  // per candidate height, while measuring
-    std::vector<float> values_;                 // S (or a pair's difference) at the region's pixels
-    std::vector<cv::Point2f> gradients_;        // the texture's gradient there, when a move is explained
-    std::vector<cv::Point2f> points_;           // the region's undistorted pixels
-    std::vector<float> residuals_;              // values_ less what their mean and a move explain
+    std::vector<float> values_;           // S (or a pair's difference) at the region's pixels
+    std::vector<cv::Point2f> gradients_;  // the texture's gradient there, when a move is explained
+    std::vector<cv::Point2f> points_;     // the region's undistorted pixels
+    std::vector<float> residuals_;        // values_ less what their mean and a move explain
+    PanelRays rays_;
 };
 
 }  // namespace everytouch::core
