@@ -21,11 +21,9 @@ int main(int argc, char** argv) {
     app.add_option("--config", options.configPath,
                    "Configuration file; its drop-ins are read from FILE.d/*.conf")
         ->capture_default_str();
-    app.add_option(
-        "--rig", options.rig,
-        "Frame source: sim[:SCENARIO][,key=value...], replay:DIR or aravis[:ID] (v4l2:/dev/videoN is "
-        "not in this build; default: [Camera] Rig= of the configuration, else sim:demo unless "
-        "--service)");
+    app.add_option("--rig", options.rig,
+                   "Frame source: sim[:SCENARIO][,key=value...], replay:DIR, aravis[:ID] or v4l2:/dev/videoN "
+                   "(default: [Camera] Rig= of the configuration, else sim:demo unless --service)");
     app.add_option("--log", options.touchLog, "Write the touch log (JSON Lines) to FILE; - for stdout");
     app.add_option(
            "--output", options.outputs,

@@ -1,9 +1,12 @@
 #pragma once
 
+#include <sys/mman.h>
 #include <systemd/sd-bus.h>
 #include <systemd/sd-event.h>
 #include <unistd.h>
 
+#include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <utility>
 
@@ -74,6 +77,38 @@ public:
 
 private:
     int fd_ = -1;
+};
+
+// Owns a memory mapping (mmap); unmaps it once.
+class MemoryMapping {
+public:
+    MemoryMapping() = default;
+    MemoryMapping(void* start, std::size_t length) : start_(start), length_(length) {}
+    MemoryMapping(MemoryMapping&& other) noexcept
+        : start_(std::exchange(other.start_, MAP_FAILED)), length_(std::exchange(other.length_, 0)) {}
+    MemoryMapping& operator=(MemoryMapping&& other) noexcept {
+        reset();
+        start_ = std::exchange(other.start_, MAP_FAILED);
+        length_ = std::exchange(other.length_, 0);
+        return *this;
+    }
+    MemoryMapping(const MemoryMapping&) = delete;
+    MemoryMapping& operator=(const MemoryMapping&) = delete;
+    ~MemoryMapping() { reset(); }
+
+    const std::uint8_t* data() const { return static_cast<const std::uint8_t*>(start_); }
+    std::size_t length() const { return length_; }
+    explicit operator bool() const { return start_ != MAP_FAILED; }
+    void reset() {
+        if (start_ != MAP_FAILED)
+            ::munmap(start_, length_);
+        start_ = MAP_FAILED;
+        length_ = 0;
+    }
+
+private:
+    void* start_ = MAP_FAILED;
+    std::size_t length_ = 0;
 };
 
 }  // namespace everytouch::io

@@ -5,6 +5,7 @@
 #include "io/replay_source.h"
 #include "io/sim_projector.h"
 #include "io/sim_source.h"
+#include "io/v4l2_source.h"
 
 namespace everytouch::service {
 
@@ -24,8 +25,8 @@ OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& 
             rig.source = std::make_unique<io::AravisSource>("--rig " + spec.toString(), spec.target, camera);
             return rig;
         case io::RigSpec::Kind::V4l2:
-            throw io::InputError("--rig " + spec.toString(), "",
-                                 "V4L2 cameras are not part of this build yet");
+            rig.source = std::make_unique<io::V4l2Source>("--rig " + spec.toString(), spec.target, camera);
+            return rig;
     }
     throw io::InputError("--rig " + spec.toString(), "", "unknown rig kind");
 }

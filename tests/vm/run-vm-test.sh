@@ -1,33 +1,37 @@
 #!/usr/bin/env bash
-# Runs uinput_device_tests and the daemon on a real Linux kernel: Debian's own kernel package (downloaded with
-# apt-get, extracted, never installed) boots under QEMU (TCG, no KVM needed) into a busybox initramfs with
-# systemd-udevd, the input rules, libinput, evemu and dbus-daemon. All cases run in one boot. Exit 0 iff the
-# guest reports "VMTEST RESULT: PASS".
+# Runs uinput_device_tests, v4l2_source_vm_tests and the daemon on a real Linux kernel: Debian's own kernel
+# package (downloaded with apt-get, extracted, never installed) boots under QEMU (TCG, no KVM needed) into a
+# busybox initramfs with systemd-udevd, the input rules, libinput, evemu, dbus-daemon and the kernel's
+# virtual video driver vivid. All cases run in one boot. Exit 0 iff the guest reports "VMTEST RESULT: PASS".
 #
 # The daemon replays a recording in the guest that the same daemon makes here first from the simulated rig
 # --recording-rig names (rendering under emulation would take minutes); it is kept in DIR/recording while the
 # daemon binary and the rig stay the same.
 #
-# usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR --recording-rig sim:SPEC
+# usage: run-vm-test.sh --work DIR --test BINARY --v4l2-test BINARY --daemon BINARY --rules DIR
+#                       --recording-rig sim:SPEC
 # environment: EVERYTOUCH_VM_CACHE  where the kernel is kept between runs (default: DIR/cache)
 #              EVERYTOUCH_VM_KERNEL_PACKAGE  a linux-image-* package to use instead of linux-image-amd64's
 #              EVERYTOUCH_VM_TIMEOUT  seconds the guest may run (default 600)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 
-work="" test_binary="" daemon="" rules="" recording_rig=""
+work="" test_binary="" v4l2_test_binary="" daemon="" rules="" recording_rig=""
 while [ $# -gt 0 ]; do
     case "$1" in
     --work) work=$2; shift 2 ;;
     --test) test_binary=$2; shift 2 ;;
+    --v4l2-test) v4l2_test_binary=$2; shift 2 ;;
     --daemon) daemon=$2; shift 2 ;;
     --rules) rules=$2; shift 2 ;;
     --recording-rig) recording_rig=$2; shift 2 ;;
     *) echo "run-vm-test.sh: unknown argument $1" >&2; exit 2 ;;
     esac
 done
-[ -n "$work" ] && [ -x "$test_binary" ] && [ -x "$daemon" ] && [ -d "$rules" ] && [ -n "$recording_rig" ] || {
-    echo "usage: run-vm-test.sh --work DIR --test BINARY --daemon BINARY --rules DIR --recording-rig sim:SPEC" >&2
+[ -n "$work" ] && [ -x "$test_binary" ] && [ -x "$v4l2_test_binary" ] && [ -x "$daemon" ] && [ -d "$rules" ] &&
+    [ -n "$recording_rig" ] || {
+    echo "usage: run-vm-test.sh --work DIR --test BINARY --v4l2-test BINARY --daemon BINARY --rules DIR" \
+        "--recording-rig sim:SPEC" >&2
     exit 2
 }
 
@@ -42,6 +46,7 @@ need evemu-record evemu-tools
 need udevadm udev
 need dbus-daemon dbus
 need apt-get apt
+need strip binutils
 busybox=$(command -v busybox)
 ldd "$busybox" >/dev/null 2>&1 && fail "$busybox is not static: install busybox-static"
 
@@ -66,23 +71,34 @@ if [ -z "$package" ]; then
 fi
 version=${package#linux-image-}
 kernel_dir=$cache/$package
-if [ ! -f "$kernel_dir/ready" ]; then
+# The modules the guest loads, in the order it loads them (each after what it depends on): the input devices,
+# then the media core and vivid.
+modules=(drivers/input/evdev drivers/input/misc/uinput
+    drivers/media/mc/mc drivers/media/v4l2-core/videodev drivers/media/common/videobuf2/videobuf2-common
+    drivers/media/common/videobuf2/videobuf2-memops drivers/media/common/videobuf2/videobuf2-v4l2
+    drivers/media/common/videobuf2/videobuf2-vmalloc drivers/media/common/videobuf2/videobuf2-dma-contig
+    drivers/media/v4l2-core/v4l2-dv-timings drivers/media/common/v4l2-tpg/v4l2-tpg drivers/media/rc/rc-core
+    drivers/media/cec/core/cec drivers/media/test-drivers/vivid/vivid)
+module_list="${modules[*]}"
+if [ ! -f "$kernel_dir/ready" ] || [ "$(cat "$kernel_dir/ready")" != "$module_list" ]; then
     echo "fetching $package"
     rm -rf "$kernel_dir"
     mkdir -p "$kernel_dir/deb" "$kernel_dir/root"
     (cd "$kernel_dir/deb" && apt-get download "$package" >/dev/null 2>&1) || fail "apt-get download $package failed"
-    dpkg-deb --fsys-tarfile "$kernel_dir"/deb/*.deb | tar -x -C "$kernel_dir/root" --wildcards \
-        "./boot/vmlinuz-$version" \
-        "./lib/modules/$version/kernel/drivers/input/evdev.ko*" \
-        "./lib/modules/$version/kernel/drivers/input/misc/uinput.ko*"
+    patterns=("./boot/vmlinuz-$version")
+    for module in "${modules[@]}"; do patterns+=("./lib/modules/$version/kernel/$module.ko*"); done
+    dpkg-deb --fsys-tarfile "$kernel_dir"/deb/*.deb | tar -x -C "$kernel_dir/root" --wildcards "${patterns[@]}"
     mkdir -p "$kernel_dir/modules"
-    for module in "$kernel_dir"/root/lib/modules/"$version"/kernel/drivers/input/{evdev,misc/uinput}.ko*; do
-        name=$(basename "$module")
-        case "$module" in
-        *.xz) xz -dc "$module" >"$kernel_dir/modules/${name%.xz}" ;;
-        *.zst) zstd -qdc "$module" >"$kernel_dir/modules/${name%.zst}" ;;
-        *) cp "$module" "$kernel_dir/modules/" ;;
+    : >"$kernel_dir/modules/order"
+    for module in "${modules[@]}"; do
+        file=$(ls "$kernel_dir"/root/lib/modules/"$version"/kernel/"$module".ko* | head -1)
+        name=$(basename "$module").ko
+        case "$file" in
+        *.xz) xz -dc "$file" >"$kernel_dir/modules/$name" ;;
+        *.zst) zstd -qdc "$file" >"$kernel_dir/modules/$name" ;;
+        *) cp "$file" "$kernel_dir/modules/$name" ;;
         esac
+        echo "$name" >>"$kernel_dir/modules/order"
     done
     # The bzImage carries the kernel as an XZ stream; its uncompressed ELF (with a PVH entry) boots faster,
     # skipping the firmware's real-mode start and the decompression under emulation.
@@ -93,7 +109,7 @@ if [ ! -f "$kernel_dir/ready" ]; then
     fi
     head -c 4 "$kernel_dir/vmlinux" 2>/dev/null | grep -q 'ELF' || cp "$kernel" "$kernel_dir/vmlinux"
     rm -rf "$kernel_dir/deb" "$kernel_dir/root/lib"
-    touch "$kernel_dir/ready"
+    echo "$module_list" >"$kernel_dir/ready"
 fi
 fetched=$(date +%s.%N)
 
@@ -146,11 +162,15 @@ for rule in 50-udev-default 60-input-id 60-evdev 60-persistent-input 70-touchpad
 done
 cp "$rules"/*.rules "$root/usr/lib/udev/rules.d/"
 cp -r /usr/share/libinput "$root/usr/share/" # libinput's quirks
-cp "$kernel_dir"/modules/*.ko "$root/usr/lib/modules/"
-cp "$test_binary" "$root/usr/local/bin/uinput_device_tests"
-copy_libraries "$test_binary"
-cp "$daemon" "$root/usr/local/bin/everytouchd"
-copy_libraries "$daemon"
+cp "$kernel_dir"/modules/*.ko "$kernel_dir/modules/order" "$root/usr/lib/modules/"
+# Without their debugging information: the initramfs unpacks into the guest's memory.
+copy_ours() {
+    strip --strip-debug -o "$root/usr/local/bin/$2" "$1"
+    copy_libraries "$1"
+}
+copy_ours "$test_binary" uinput_device_tests
+copy_ours "$v4l2_test_binary" v4l2_source_vm_tests
+copy_ours "$daemon" everytouchd
 mkdir -p "$root/usr/local/share/everytouch"
 cp -r "$recording" "$root/usr/local/share/everytouch/recording"
 echo 'root:x:0:0:root:/root:/bin/sh' >"$root/etc/passwd"
