@@ -1,10 +1,17 @@
 #include "io/recording.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string_view>
+#include <system_error>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -256,31 +263,114 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const R
     if (!cv::imwrite((directory / "pattern.png").string(), rig.pattern * 255))
         throw InputError((directory / "pattern.png").string(), "", "cannot be written");
 
-    framesCsv_.open(directory / "frames.csv");
-    framesCsv_ << "index,timestamp_us,polarity\n";
-    if (withTruth) {
-        truthCsv_.open(directory / "truth.csv");
-        truthCsv_ << "index,id,x,y,height_mm\n";
+    const auto openTable = [&](const char* name, std::string_view header, UniqueFd& table, off_t& size) {
+        const std::filesystem::path path = directory / name;
+        table.reset(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+        if (!table)
+            throw InputError(path.string(), "", std::string("cannot be written: ") + std::strerror(errno));
+        appendLine(table, header, path, size);
+    };
+    openTable("frames.csv", "index,timestamp_us,polarity\n", framesCsv_, framesSize_);
+    if (withTruth)
+        openTable("truth.csv", "index,id,x,y,height_mm\n", truthCsv_, truthSize_);
+    framesComplete_ = framesSize_;
+    truthComplete_ = truthSize_;
+}
+
+void RecordingWriter::begin(std::uint64_t index) {
+    if (openIndex_ == index)
+        return;
+    framesComplete_ = framesSize_;
+    truthComplete_ = truthSize_;
+    openImages_.clear();
+    openFrames_ = 0;
+    openIndex_ = index;
+}
+
+template <typename Write>
+void RecordingWriter::guarded(std::uint64_t index, Write write) {
+    if (stopped_)
+        throw std::logic_error(directory_.string() + ": the recording stopped at a failed write");
+    begin(index);
+    try {
+        write();
+    } catch (...) {
+        takeBackOpenFrame();
+        stopped_ = true;
+        throw;
     }
-    if (!framesCsv_ || (withTruth && !truthCsv_))
-        throw InputError(directory.string(), "", "cannot write the frame and truth tables");
+}
+
+void RecordingWriter::takeBackOpenFrame() noexcept {
+    std::error_code ignored;
+    for (const std::filesystem::path& image : openImages_)
+        std::filesystem::remove(image, ignored);
+    openImages_.clear();
+    // What cannot be cut off was not written either: the disk refused it.
+    if (framesCsv_ && ::ftruncate(framesCsv_.get(), framesComplete_) == 0)
+        framesSize_ = framesComplete_;
+    if (truthCsv_ && ::ftruncate(truthCsv_.get(), truthComplete_) == 0)
+        truthSize_ = truthComplete_;
+    framesWritten_ -= openFrames_;
+    openFrames_ = 0;
+}
+
+void RecordingWriter::writeImage(const std::filesystem::path& path, const cv::Mat& image) {
+    if (!cv::imencode(".png", image, encoded_))
+        throw std::runtime_error(path.string() + ": the image cannot be encoded as PNG");
+    UniqueFd file(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+    if (!file)
+        throw std::system_error(errno, std::generic_category(), path.string());
+    openImages_.push_back(path);
+    off_t size = 0;
+    appendLine(file, std::string_view(reinterpret_cast<const char*>(encoded_.data()), encoded_.size()), path,
+               size);
+    if (::close(file.release()) != 0)
+        throw std::system_error(errno, std::generic_category(), path.string());
+}
+
+void RecordingWriter::appendLine(const UniqueFd& table, std::string_view line,
+                                 const std::filesystem::path& path, off_t& size) {
+    while (!line.empty()) {
+        const ssize_t written = ::write(table.get(), line.data(), line.size());
+        if (written < 0 && errno == EINTR)
+            continue;
+        if (written <= 0)
+            throw std::system_error(written < 0 ? errno : ENOSPC, std::generic_category(), path.string());
+        line.remove_prefix(static_cast<std::size_t>(written));
+        size += written;
+    }
 }
 
 void RecordingWriter::addFrame(const core::Frame& frame) {
-    const std::filesystem::path path = Recording::framePath(directory_, frame.index);
-    if (!cv::imwrite(path.string(), frame.image))
-        throw InputError(path.string(), "", "cannot be written");
-    framesCsv_ << frame.index << ',' << frame.timestampUs << ',' << static_cast<int>(frame.polarity) << '\n';
+    guarded(frame.index, [&] {
+        writeImage(Recording::framePath(directory_, frame.index), frame.image);
+        char line[96];
+        const int length =
+            std::snprintf(line, sizeof line, "%llu,%lld,%d\n", static_cast<unsigned long long>(frame.index),
+                          static_cast<long long>(frame.timestampUs), static_cast<int>(frame.polarity));
+        appendLine(framesCsv_, std::string_view(line, static_cast<std::size_t>(length)),
+                   directory_ / "frames.csv", framesSize_);
+        ++framesWritten_;
+        openFrames_ = 1;
+    });
 }
 
 void RecordingWriter::addTruth(const std::vector<core::FingerTruth>& fingers) {
-    char line[160];
-    for (const core::FingerTruth& finger : fingers) {
-        std::snprintf(line, sizeof line, "%llu,%u,%.3f,%.3f,%.3f\n",
-                      static_cast<unsigned long long>(finger.frameIndex), finger.id, finger.x, finger.y,
-                      finger.heightMm);
-        truthCsv_ << line;
-    }
+    if (!truthCsv_)
+        throw std::logic_error("addTruth: the recording was started without truth");
+    if (fingers.empty())
+        return;
+    guarded(fingers.front().frameIndex, [&] {
+        char line[160];
+        for (const core::FingerTruth& finger : fingers) {
+            const int length = std::snprintf(line, sizeof line, "%llu,%u,%.3f,%.3f,%.3f\n",
+                                             static_cast<unsigned long long>(finger.frameIndex), finger.id,
+                                             finger.x, finger.y, finger.heightMm);
+            appendLine(truthCsv_, std::string_view(line, static_cast<std::size_t>(length)),
+                       directory_ / "truth.csv", truthSize_);
+        }
+    });
 }
 
 void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
@@ -288,14 +378,20 @@ void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
         throw std::logic_error("addMask: the recording was started without masks");
     if (mask.type() != CV_8UC1 || mask.size() != cameraSize_)
         throw std::invalid_argument("addMask: expected an 8-bit single-channel mask of the camera size");
-    const std::filesystem::path path = Recording::maskPath(directory_, frameIndex);
-    if (!cv::imwrite(path.string(), mask))
-        throw InputError(path.string(), "", "cannot be written");
+    guarded(frameIndex, [&] { writeImage(Recording::maskPath(directory_, frameIndex), mask); });
 }
 
 void RecordingWriter::flush() {
-    framesCsv_.flush();
-    truthCsv_.flush();
+    if (stopped_)
+        return;
+    openIndex_.reset();
+    framesComplete_ = framesSize_;
+    truthComplete_ = truthSize_;
+    openImages_.clear();
+    openFrames_ = 0;
+    for (const UniqueFd* table : {&framesCsv_, &truthCsv_})
+        if (*table && ::fdatasync(table->get()) != 0)
+            throw std::system_error(errno, std::generic_category(), directory_.string() + ": the tables");
 }
 
 }  // namespace everytouch::io

@@ -2,7 +2,8 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core/mat.hpp>
@@ -10,6 +11,7 @@
 #include "core/calibration.h"
 #include "core/contact.h"
 #include "core/frame.h"
+#include "io/handles.h"
 #include "io/rig_description.h"
 
 namespace everytouch::io {
@@ -60,6 +62,11 @@ private:
 
 // Writes a recording directory from any rig. The directory must not exist or be empty. With truth, truth.csv
 // takes the fingers of every frame; with masks, masks/ takes the hand mask of every frame.
+//
+// A frame's image, mask and lines are kept or dropped together: when a write fails (the disk full), what was
+// written of the frame being added is taken away again, so that the recording holds every frame before it
+// and reads as any other; the call throws std::system_error naming the file, and every later call
+// std::logic_error. A frame is complete once a call names the next frame's index (or flush() came).
 class RecordingWriter {
 public:
     RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig, bool withTruth,
@@ -70,14 +77,36 @@ public:
     // The hand mask of frame `frameIndex`: CV_8UC1, camera size, 0 and 255. Throws std::logic_error for a
     // writer without masks and std::invalid_argument for another type or size.
     void addMask(std::uint64_t frameIndex, const cv::Mat& mask);
+    // Completes the last frame and puts the tables on the disk (fdatasync).
     void flush();
 
+    // Frames in frames.csv.
+    std::uint64_t framesWritten() const { return framesWritten_; }
+
 private:
+    // Starts frame `index` unless it is the one being written: the one before is then complete.
+    void begin(std::uint64_t index);
+    // Runs `write`; when it throws, takes the open frame away and stops the writer.
+    template <typename Write>
+    void guarded(std::uint64_t index, Write write);
+    void takeBackOpenFrame() noexcept;
+    void writeImage(const std::filesystem::path& path, const cv::Mat& image);
+    void appendLine(const UniqueFd& table, std::string_view line, const std::filesystem::path& path,
+                    off_t& size);
+
     std::filesystem::path directory_;
     cv::Size cameraSize_;
     bool withMasks_;
-    std::ofstream framesCsv_;
-    std::ofstream truthCsv_;
+    UniqueFd framesCsv_;
+    UniqueFd truthCsv_;
+    off_t framesSize_ = 0, truthSize_ = 0;           // bytes written
+    off_t framesComplete_ = 0, truthComplete_ = 0;   // bytes of the complete frames
+    std::optional<std::uint64_t> openIndex_;         // the frame being written
+    std::vector<std::filesystem::path> openImages_;  // its files
+    std::uint64_t openFrames_ = 0;                   // 1 once its line is in frames.csv
+    std::uint64_t framesWritten_ = 0;
+    bool stopped_ = false;
+    std::vector<uchar> encoded_;
 };
 
 }  // namespace everytouch::io

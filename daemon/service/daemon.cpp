@@ -570,6 +570,12 @@ void Daemon::shutDown() {
                          ? "; the frames' order was swapped " + std::to_string(statistics.polaritySwaps) +
                                " times by the code's sign"
                          : std::string());
+    if (!statistics.recordingStopped.empty()) {
+        // Detection went on to the end, but what was asked for is not all there.
+        ET_LOG(Error) << options_.recordDir.string() << " is incomplete: " << statistics.recordingStopped;
+        if (exitStatus_ == kExitSuccess)
+            exitStatus_ = kExitFailure;
+    }
     snapshots_.reset();
     loop_.reset();
 }

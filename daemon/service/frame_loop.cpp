@@ -179,13 +179,7 @@ void FrameLoop::runCamera() {
             sourceBack();
             backOff = kFirstReconnectWait;
             item.frame = std::move(*frame);
-            if (recorder_) {
-                recorder_->addFrame(item.frame);
-                if (const auto truth = source_.truth())
-                    recorder_->addTruth(*truth);
-                if (const auto mask = source_.truthMask())
-                    recorder_->addMask(item.frame.index, *mask);
-            }
+            record(item.frame);
         } catch (const io::SourceLost& lost) {
             if (!waitForLostSource(lost.what(), backOff))
                 break;
@@ -203,14 +197,38 @@ void FrameLoop::runCamera() {
         if (!queue_.push(std::move(item)))
             break;
     }
-    if (recorder_) {
+    if (recorder_ && !recordingStopped_) {
         try {
             recorder_->flush();
         } catch (const std::exception& error) {
-            fail(std::string("recording: ") + error.what());
+            stopRecording(error.what());
         }
     }
     queue_.close();
+}
+
+void FrameLoop::record(const core::Frame& frame) {
+    if (!recorder_ || recordingStopped_)
+        return;
+    try {
+        recorder_->addFrame(frame);
+        if (const auto truth = source_.truth())
+            recorder_->addTruth(*truth);
+        if (const auto mask = source_.truthMask())
+            recorder_->addMask(frame.index, *mask);
+    } catch (const std::exception& error) {
+        stopRecording(error.what());
+    }
+}
+
+void FrameLoop::stopRecording(const std::string& problem) {
+    recordingStopped_ = true;
+    const std::string stopped = "the recording stopped: " + problem + "; it keeps the " +
+                                std::to_string(recorder_->framesWritten()) +
+                                " frames before, and detection goes on";
+    ET_LOG(Error) << stopped;
+    std::lock_guard lock(mutex_);
+    statistics_.recordingStopped = stopped;
 }
 
 void FrameLoop::publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts) {

@@ -39,6 +39,8 @@ struct LoopStatistics {
     // How often the code's sign swapped the order in which the camera's frames are taken (a camera that
     // started on the O - P frame, a refresh the projector missed; core/polarity_lock.h).
     std::uint64_t polaritySwaps = 0;
+    // Why the recording stopped before the stream did (a full disk), with what it kept; empty otherwise.
+    std::string recordingStopped;
 };
 
 struct LoopOptions {
@@ -99,6 +101,9 @@ private:
     void publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts);
     void processPair(const core::FramePair& pair, const core::PipelineSettings& settings);
     void recordPipelineTime(double ms);
+    // Adds a frame to the recording; a write that fails stops the recording, never the detection.
+    void record(const core::Frame& frame);
+    void stopRecording(const std::string& problem);
     void fail(const std::string& problem);
     // The camera thread's side of a lost camera: says so once, has the contacts released, and waits
     // `backOff` (doubled for the next time) before the source is asked again. False when stopping.
@@ -120,8 +125,8 @@ private:
     std::atomic<bool> finished_{false};
     std::atomic<bool> detecting_{false};
     std::atomic<bool> failingNow_{false};
-    std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)  // the last
-                                       // pair failed; its failure has been logged once
+    std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)
+    bool recordingStopped_ = false;    // camera thread
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
     std::thread pipelineThread_;

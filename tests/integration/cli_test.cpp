@@ -1,4 +1,7 @@
 // Runs the real everytouchd and everytouch-calib binaries.
+#include <unistd.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -148,6 +151,63 @@ TEST(Everytouchd, FramesLabelledTheOtherWayRoundGiveTheSameTouches) {
         EXPECT_EQ(logs[1][i].index, logs[0][i].index);
         EXPECT_EQ(logs[1][i].contacts, logs[0][i].contacts) << "frame " << logs[0][i].index;
     }
+}
+
+TEST(Everytouchd, ADiskThatFillsStopsTheRecordingNotTheDetection) {
+    // A real full disk: a 1.5 MB tmpfs in a mount namespace of the daemon's own, which holds three frames.
+    if (geteuid() != 0 || !std::filesystem::exists("/usr/bin/unshare") ||
+        test::runProcess({"/usr/bin/unshare", "-m", "true"}).exitCode != 0)
+        GTEST_SKIP() << "a small filesystem of the test's own needs root and unshare -m";
+    test::TempDir dir;
+    const std::vector<std::string> session = {"--rig", "sim:grid35,start=1.6", "--fast", "--frames", "40"};
+    std::vector<std::string> plain = {EVERYTOUCHD_PATH};
+    plain.insert(plain.end(), session.begin(), session.end());
+    plain.insert(plain.end(), {"--log", (dir / "plain.jsonl").string()});
+    const test::ProcessResult unrecorded = test::runProcess(plain);
+    ASSERT_EQ(unrecorded.exitCode, 0) << unrecorded.err;
+
+    std::filesystem::create_directory(dir / "small");
+    std::vector<std::string> recording = {"/usr/bin/unshare",
+                                          "-m",
+                                          "/bin/sh",
+                                          "-c",
+                                          "mount -t tmpfs -o size=1536k tmpfs \"$1\" || exit 99; shift; "
+                                          "\"$@\"; status=$?; cp -r \"$SMALL/rec\" \"$KEPT\"; exit $status",
+                                          "sh",
+                                          (dir / "small").string(),
+                                          EVERYTOUCHD_PATH};
+    recording.insert(recording.end(), session.begin(), session.end());
+    recording.insert(recording.end(), {"--log", (dir / "recorded.jsonl").string(), "--record",
+                                       (dir / "small" / "rec").string()});
+    ::setenv("SMALL", (dir / "small").c_str(), 1);
+    ::setenv("KEPT", (dir / "kept").c_str(), 1);
+    const test::ProcessResult recorded = test::runProcess(recording);
+    ::unsetenv("SMALL");
+    ::unsetenv("KEPT");
+    ASSERT_NE(recorded.exitCode, 99) << "no tmpfs: " << recorded.err;
+    EXPECT_EQ(recorded.exitCode, 1) << "the recording asked for is incomplete";
+    EXPECT_THAT(recorded.err, HasSubstr("the recording stopped: "));
+    EXPECT_THAT(recorded.err, HasSubstr("No space left on device"));
+    EXPECT_THAT(recorded.err, HasSubstr("detection goes on"));
+    EXPECT_THAT(recorded.err, HasSubstr("processed 40 frames"));
+
+    // Detection went on as without the recording, frame for frame.
+    const std::vector<io::TouchLogEntry> expected = io::readTouchLog(dir / "plain.jsonl");
+    const std::vector<io::TouchLogEntry> detected = io::readTouchLog(dir / "recorded.jsonl");
+    ASSERT_EQ(detected.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        EXPECT_EQ(detected[i].index, expected[i].index);
+        EXPECT_EQ(detected[i].contacts, expected[i].contacts) << "frame " << expected[i].index;
+    }
+    // What the disk held is a recording that plays.
+    const io::Recording kept = io::Recording::open(dir / "kept");
+    ASSERT_GE(kept.frames().size(), 1u);
+    EXPECT_LT(kept.frames().size(), 40u);
+    for (std::size_t i = 0; i < kept.frames().size(); ++i)
+        EXPECT_FALSE(kept.loadFrame(i).image.empty());
+    const test::ProcessResult replayed =
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "replay:" + (dir / "kept").string(), "--fast"});
+    EXPECT_EQ(replayed.exitCode, 0) << replayed.err;
 }
 
 TEST(Everytouchd, BadSimulatorOptionIsAUsageError) {

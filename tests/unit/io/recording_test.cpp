@@ -1,5 +1,8 @@
 #include "io/recording.h"
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <regex>
 
 #include <gmock/gmock.h>
@@ -260,6 +263,73 @@ TEST_F(RecordingTest, FrameOfWrongSizeIsRejectedWhenRead) {
     const Recording recording = Recording::open(dir_.path());
     EXPECT_THAT([&] { recording.loadFrame(1); },
                 ::testing::ThrowsMessage<InputError>(HasSubstr("000001.png")));
+}
+
+// A file size limit makes the writes of one frame fail as a full disk would, in this process and without
+// privileges: the frame's image is refused (EFBIG), its truth and mask, written before, are taken back.
+class FileSizeLimit {
+public:
+    explicit FileSizeLimit(rlim_t bytes) {
+        getrlimit(RLIMIT_FSIZE, &saved_);
+        previousHandler_ = std::signal(SIGXFSZ, SIG_IGN);
+        rlimit limit = saved_;
+        limit.rlim_cur = bytes;
+        setrlimit(RLIMIT_FSIZE, &limit);
+    }
+    ~FileSizeLimit() {
+        setrlimit(RLIMIT_FSIZE, &saved_);
+        std::signal(SIGXFSZ, previousHandler_);
+    }
+    FileSizeLimit(const FileSizeLimit&) = delete;
+    FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+private:
+    rlimit saved_{};
+    void (*previousHandler_)(int) = SIG_DFL;
+};
+
+TEST(RecordingWriterTest, AWriteThatFailsTakesItsFrameBackAndKeepsEveryFrameBefore) {
+    const test::TempDir dir;
+    const RigDescription rig = test::paperLikeRig();
+    const cv::Size size = rig.calibration.cameraSize;
+    RecordingWriter writer(dir / "rec", rig, true, true);
+    for (std::uint64_t i = 0; i < 4; ++i) {
+        core::Frame frame = makeFrame(i, size);
+        // Flat frames make small files; the fourth is noise, larger than the limit below.
+        if (i < 3)
+            frame.image.setTo(cv::Scalar(90, 120, 150));
+        writer.addTruth({{i, 1, 10.0 + i, 20.0, 1.5}});
+        writer.addMask(i, makeMask(i, size));
+        if (i < 3) {
+            writer.addFrame(frame);
+            continue;
+        }
+        const FileSizeLimit limit(64 * 1024);
+        try {
+            writer.addFrame(frame);
+            FAIL() << "a frame larger than the file size limit was written";
+        } catch (const std::system_error& error) {
+            EXPECT_THAT(error.what(), HasSubstr("frames/000003.png"));
+            EXPECT_THAT(error.what(), HasSubstr("File too large"));
+        }
+    }
+    EXPECT_EQ(writer.framesWritten(), 3u);
+    EXPECT_THROW(writer.addFrame(makeFrame(4, size)), std::logic_error);
+    writer.flush();
+
+    const Recording recording = Recording::open(dir / "rec");
+    ASSERT_EQ(recording.frames().size(), 3u);
+    EXPECT_EQ(recording.frames().back().index, 2u);
+    ASSERT_EQ(recording.truth().size(), 3u);
+    EXPECT_EQ(recording.truth().back().frameIndex, 2u);
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_EQ(cv::norm(recording.loadFrame(i).image, cv::Mat(size, CV_8UC3, cv::Scalar(90, 120, 150)),
+                           cv::NORM_INF),
+                  0.0);
+        EXPECT_EQ(cv::norm(recording.loadMask(i), makeMask(i, size), cv::NORM_INF), 0.0);
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "rec" / "masks" / "000003.png"));
+    EXPECT_FALSE(std::filesystem::exists(dir / "rec" / "frames" / "000003.png"));
 }
 
 }  // namespace
