@@ -24,6 +24,10 @@ void SnapshotRequests::add(SnapshotKind kind, int fd, SnapshotReply reply) {
         throw BusError(SD_BUS_ERROR_INVALID_ARGS, "The file descriptor is not open for writing");
     if (loop_.finished())
         throw BusError(bus::kErrorNoCamera, "The camera delivers no frames");
+    if (requests_.size() >= kMostPending)
+        throw BusError(bus::kErrorBusy,
+                       std::to_string(kMostPending) +
+                           " snapshots are being taken already; ask again once they are answered");
     const std::uint64_t id = nextId_++;
     Request& request = requests_[id];
     if (const int r = request.writer.adopt(fd); r < 0) {

@@ -43,6 +43,10 @@ struct SnapshotTimeouts {
 // only.
 class SnapshotRequests {
 public:
+    // Requests held at once, each with its caller's descriptor: a client that floods the daemon with
+    // snapshots gets Busy beyond these instead of using up the daemon's descriptors and main thread.
+    static constexpr std::size_t kMostPending = 8;
+
     // `event` runs the timeouts; `inbox` brings the pairs from the pipeline thread to the main thread. All
     // three must outlive the requests, and no task the inbox holds may run once they are gone.
     SnapshotRequests(sd_event* event, FrameLoop& loop, MainLoopInbox& inbox, SnapshotRenderer render,
@@ -51,8 +55,8 @@ public:
     SnapshotRequests& operator=(const SnapshotRequests&) = delete;
 
     // Takes a request for `kind` of the next pair, to be written to `fd`, which stays the caller's. Throws
-    // BusError when the descriptor is not open for writing or cannot be kept, or the camera delivers no
-    // frames.
+    // BusError when the descriptor is not open for writing or cannot be kept, the camera delivers no frames,
+    // or kMostPending requests are waiting (Busy).
     void add(SnapshotKind kind, int fd, SnapshotReply reply);
     // Answers every pending request with this error.
     void failAll(const char* errorName, const std::string& message);

@@ -35,6 +35,7 @@
 #include "io/recording.h"
 #include "io/touch_log.h"
 #include "service/bus_names.h"
+#include "service/snapshot_requests.h"
 #include "service/table_set_up_step.h"
 #include "sim/rig_geometry.h"
 #include "sim/sim_parameters.h"
@@ -813,6 +814,85 @@ TEST_F(ServiceTest, SurvivesClientsThatDisconnectMidCall) {
     EXPECT_TRUE(daemon_->running());
 }
 
+// How a flood of Snapshot calls was answered.
+struct SnapshotReplies {
+    int answered = 0, busy = 0, ioError = 0, succeeded = 0;
+    std::string others;
+
+    static int onReply(sd_bus_message* reply, void* userdata, sd_bus_error*) {
+        auto* replies = static_cast<SnapshotReplies*>(userdata);
+        ++replies->answered;
+        if (sd_bus_message_is_method_error(reply, bus::kErrorBusy))
+            ++replies->busy;
+        else if (sd_bus_message_is_method_error(reply, SD_BUS_ERROR_IO_ERROR))
+            ++replies->ioError;
+        else if (const sd_bus_error* error = sd_bus_message_get_error(reply))
+            replies->others +=
+                std::string(error->name) + ": " + (error->message ? error->message : "") + "\n";
+        else
+            ++replies->succeeded;
+        return 0;
+    }
+};
+
+TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
+    startDaemon();
+    const auto frameRate = [this] {
+        double perSecond = 0.0;
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &perSecond);
+        return perSecond;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline && frameRate() < 8.0)
+        std::this_thread::sleep_for(100ms);
+    ASSERT_GT(frameRate(), 8.0);  // the recording runs at 10 frames/s
+
+    // 40 calls at once, each with a pipe nobody reads, already full: the first eight are held until their
+    // writes time out (3 s), the others are refused at once.
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus client(raw);
+    constexpr int kCalls = 40;
+    std::vector<io::UniqueFd> readEnds, writeEnds;
+    SnapshotReplies replies;
+    for (int i = 0; i < kCalls; ++i) {
+        int ends[2];
+        ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
+        readEnds.emplace_back(ends[0]);
+        writeEnds.emplace_back(ends[1]);
+        ASSERT_GE(::fcntl(ends[1], F_SETPIPE_SZ, 4096), 0);
+        ASSERT_EQ(::fcntl(ends[1], F_SETFL, O_NONBLOCK), 0);
+        const std::string page(4096, 'x');
+        while (::write(ends[1], page.data(), page.size()) > 0) {
+        }
+        ASSERT_GE(sd_bus_call_method_async(client.get(), nullptr, bus::kBusName, bus::kObjectPath,
+                                           bus::kInterface, "Snapshot", SnapshotReplies::onReply, &replies,
+                                           "sh", "overlay", ends[1]),
+                  0);
+    }
+    const auto waitForReplies = [&](int count, std::chrono::milliseconds within) {
+        const auto until = std::chrono::steady_clock::now() + within;
+        while (replies.answered < count && std::chrono::steady_clock::now() < until) {
+            if (sd_bus_process(client.get(), nullptr) > 0)
+                continue;
+            sd_bus_wait(client.get(), 100'000);
+        }
+    };
+    waitForReplies(kCalls - static_cast<int>(service::SnapshotRequests::kMostPending), 2s);
+    EXPECT_EQ(replies.busy, kCalls - static_cast<int>(service::SnapshotRequests::kMostPending));
+    // Meanwhile the frames go on.
+    EXPECT_GT(frameRate(), 8.0);
+    waitForReplies(kCalls, 10s);
+    EXPECT_EQ(replies.answered, kCalls);
+    EXPECT_EQ(replies.ioError, static_cast<int>(service::SnapshotRequests::kMostPending));
+    EXPECT_EQ(replies.others, "");
+    // Once they are answered, snapshots are taken again.
+    const test::ProcessResult snapshot =
+        test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "after.png").string()});
+    EXPECT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    EXPECT_TRUE(daemon_->running());
+}
+
 TEST_F(ServiceTest, SigtermStopsCleanlyAndReleasesContacts) {
     startDaemon({"--log", (dir_ / "touches.jsonl").string()});
     daemon_->signal(SIGTERM);
@@ -901,6 +981,32 @@ TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveO
     result = test::runProcess(call("SaveCalibration"));
     EXPECT_THAT(result.err, HasSubstr("There is no calibration to save"));
     EXPECT_TRUE(std::filesystem::exists(dir_ / "calibration.yml"));
+}
+
+TEST_F(ServiceTest, ACalibrationFileTurnedToGarbageWhileRunningChangesNothingUntilSavedAtomically) {
+    core::Calibration stored = test::smallRig().calibration;
+    stored.displayToProjector(0, 2) = 3.25;
+    io::writeCalibrationFile(dir_ / "calibration.yml", stored);
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    startDaemon();
+    ASSERT_EQ(get("Calibrated"), "b true\n");
+    const std::string state = get("State");
+
+    std::ofstream(dir_ / "calibration.yml", std::ios::trunc) << std::string("\x00\xff{{ not yaml at all", 20);
+    daemon_->signal(SIGHUP);
+    ASSERT_TRUE(waitForLog("configuration reloaded"));
+    ASSERT_EQ(test::runProcess(call("ReloadConfig")).exitCode, 0);
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    EXPECT_EQ(get("State"), state);
+
+    struct stat garbage {};
+    ASSERT_EQ(::stat((dir_ / "calibration.yml").c_str(), &garbage), 0);
+    const test::ProcessResult save = test::runProcess(call("SaveCalibration"));
+    ASSERT_EQ(save.exitCode, 0) << save.err;
+    struct stat saved {};
+    ASSERT_EQ(::stat((dir_ / "calibration.yml").c_str(), &saved), 0);
+    EXPECT_NE(saved.st_ino, garbage.st_ino) << "not replaced by rename";
+    EXPECT_DOUBLE_EQ(io::readCalibrationFile(dir_ / "calibration.yml").displayToProjector(0, 2), 3.25);
 }
 
 TEST_F(ServiceTest, ARigWithoutACalibrationFileCannotSave) {
