@@ -9,6 +9,7 @@
 
 #include <csignal>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <regex>
@@ -726,6 +727,119 @@ TEST(Everytouchd, ReplaysARecordedDragOntoItsTouchscreen) {
     EXPECT_GE(motions, moved);
     EXPECT_LE(motions, touchingFrames);
     EXPECT_GT(moved, 10u) << "the finger hardly moved while touching";
+}
+
+// What libinput saw of a touchscreen: how many touches went down, and the slots still down at the end.
+struct LibinputBalance {
+    std::size_t downs = 0;
+    std::set<int> leftDown;
+};
+
+LibinputBalance libinputBalance(const std::string& output) {
+    LibinputBalance balance;
+    for (const LibinputTouch& touch : libinputTouches(output)) {
+        if (touch.type == "TOUCH_DOWN") {
+            ++balance.downs;
+            balance.leftDown.insert(touch.slot);
+        } else if (touch.type == "TOUCH_UP" || touch.type == "TOUCH_CANCEL") {
+            balance.leftDown.erase(touch.slot);
+        }
+    }
+    return balance;
+}
+
+// How the daemon is interrupted while a finger touches.
+enum class Interruption { Terminate, Kill, ReloadABrokenFile };
+
+// everytouchd replays the drag onto its touchscreen; once its log shows the finger touching it is
+// interrupted. Whatever the interruption, no touch stays down as libinput sees it. Returns libinput's output.
+std::string interruptMidTouch(Interruption interruption, const test::TempDir& dir, const std::string& name) {
+    const char* recordingPath = std::getenv("EVERYTOUCH_TEST_RECORDING");
+    const char* daemonPath = std::getenv("EVERYTOUCHD");
+    const std::filesystem::path config = dir / (name + ".conf");
+    std::ofstream(config) << "[Touch]\nHeightMm=3\n";
+    const std::filesystem::path log = dir / (name + ".jsonl");
+    const std::set<std::filesystem::path> before = eventNodes();
+    test::BackgroundProcess daemon(
+        {daemonPath ? daemonPath : EVERYTOUCHD_PATH, "--config", config.string(), "--rig",
+         std::string("replay:") + recordingPath, "--fast", "--output", "uinput", "--log", log.string()},
+        dir / (name + ".log"));
+    std::filesystem::path devnode;
+    const bool appeared = waitFor([&] {
+        for (const std::filesystem::path& node : eventNodes())
+            if (!before.contains(node))
+                devnode = node;
+        return !devnode.empty() || !daemon.running();
+    });
+    daemon.signal(SIGSTOP);
+    EXPECT_TRUE(appeared && !devnode.empty()) << "no touchscreen appeared\n" << daemon.output();
+    if (devnode.empty())
+        return {};
+    udevProperties(devnode);
+    test::BackgroundProcess libinput({"libinput", "debug-events", "--device", devnode.string()},
+                                     dir / (name + ".libinput"));
+    EXPECT_TRUE(attached(libinput, devnode)) << "libinput debug-events never opened " << devnode;
+    daemon.signal(SIGCONT);
+    // Interrupted once the touch has reached libinput (the touch log, written first, is not enough).
+    const bool touching = waitFor([&] {
+        return test::fileContents(dir / (name + ".libinput")).find("TOUCH_DOWN") != std::string::npos ||
+               !daemon.running();
+    });
+    daemon.signal(SIGSTOP);
+    EXPECT_TRUE(touching && daemon.running()) << "libinput saw no touch\n" << daemon.output();
+
+    switch (interruption) {
+        case Interruption::Terminate:
+            daemon.signal(SIGTERM);
+            daemon.signal(SIGCONT);
+            EXPECT_EQ(daemon.wait(kPatience), 0) << daemon.output();
+            break;
+        case Interruption::Kill:
+            daemon.signal(SIGKILL);
+            EXPECT_EQ(daemon.wait(kPatience), 128 + SIGKILL);
+            break;
+        case Interruption::ReloadABrokenFile: {
+            const std::size_t logged = test::fileContents(log).size();
+            std::ofstream(config, std::ios::trunc) << "[Touch]\nHeightMm=banana\n";
+            daemon.signal(SIGHUP);
+            daemon.signal(SIGCONT);
+            EXPECT_TRUE(daemon.waitForOutput("the running configuration stays in effect", kPatience))
+                << daemon.output();
+            // Detection goes on through the rejected reload: the finger is followed until it lifts.
+            EXPECT_TRUE(
+                waitFor([&] { return logsALift(test::fileContents(log)) || !daemon.running(); }, 300s));
+            EXPECT_GT(test::fileContents(log).size(), logged) << "nothing was detected after the reload";
+            daemon.signal(SIGTERM);
+            EXPECT_EQ(daemon.wait(kPatience), 0) << daemon.output();
+            break;
+        }
+    }
+    EXPECT_TRUE(waitFor([&] { return !std::filesystem::exists(devnode); })) << devnode << " stayed";
+    std::this_thread::sleep_for(300ms);
+    libinput.signal(SIGINT);
+    libinput.wait(kPatience);
+    return test::fileContents(dir / (name + ".libinput"));
+}
+
+TEST(Everytouchd, NoTouchStaysDownWhenTheDaemonIsStoppedKilledOrReloadedMidTouch) {
+    SKIP_WITHOUT_UINPUT();
+    if (!std::getenv("EVERYTOUCH_TEST_RECORDING"))
+        GTEST_SKIP() << "EVERYTOUCH_TEST_RECORDING names no recording with a touch (tests/vm sets it)";
+    test::TempDir dir;
+    // The kill first: the daemons after it start again as systemd would start them, and must begin with a
+    // touchscreen of their own and nothing down.
+    for (const auto& [interruption, name] :
+         {std::pair{Interruption::Kill, "kill"}, std::pair{Interruption::Terminate, "terminate"},
+          std::pair{Interruption::ReloadABrokenFile, "reload"}}) {
+        SCOPED_TRACE(name);
+        const std::string seen = interruptMidTouch(interruption, dir, name);
+        const LibinputBalance balance = libinputBalance(seen);
+        EXPECT_GE(balance.downs, 1u) << seen;
+        EXPECT_TRUE(balance.leftDown.empty()) << "slots left down: " << balance.leftDown.size() << "\n"
+                                              << seen;
+        std::cout << name << ": libinput saw " << balance.downs << " touch-downs, "
+                  << (seen.find("TOUCH_CANCEL") != std::string::npos ? "cancelled" : "lifted") << "\n";
+    }
 }
 
 }  // namespace
