@@ -85,6 +85,27 @@ std::string sizeText(const cv::Size& size) {
     return std::to_string(size.width) + "x" + std::to_string(size.height);
 }
 
+// Checks from its header alone that `path` is a PNG of `size`, before anything is decoded: OpenCV allocates
+// the image a header declares before it reads a pixel, and a broken or hostile file may declare a gigapixel.
+// `sizeName` says whose size it must have.
+void requirePngOfSize(const std::filesystem::path& path, const cv::Size& size, const std::string& sizeName) {
+    constexpr unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    unsigned char header[24] = {};
+    std::ifstream file(path, std::ios::binary);
+    if (!file.read(reinterpret_cast<char*>(header), sizeof header) ||
+        std::memcmp(header, kSignature, sizeof kSignature) != 0 || std::memcmp(header + 12, "IHDR", 4) != 0)
+        throw InputError(path.string(), "", "not a readable PNG image");
+    const auto bigEndian = [&header](int at) {
+        return (std::uint32_t{header[at]} << 24) | (std::uint32_t{header[at + 1]} << 16) |
+               (std::uint32_t{header[at + 2]} << 8) | std::uint32_t{header[at + 3]};
+    };
+    const std::uint32_t width = bigEndian(16), height = bigEndian(20);
+    if (width != static_cast<std::uint32_t>(size.width) || height != static_cast<std::uint32_t>(size.height))
+        throw InputError(path.string(), "",
+                         "expected the " + sizeName + " " + sizeText(size) + ", found " +
+                             std::to_string(width) + "x" + std::to_string(height));
+}
+
 // Reads an 8-bit single-channel image of `size` that holds only 0 and 255; `sizeName` says whose size it must
 // have.
 cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
@@ -92,6 +113,7 @@ cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
     const std::string name = path.string();
     if (!std::filesystem::is_regular_file(path))
         throw InputError(name, "", "missing");
+    requirePngOfSize(path, size, sizeName);
     cv::Mat image = cv::imread(name, cv::IMREAD_UNCHANGED);
     if (image.empty())
         throw InputError(name, "", "not a readable image");
@@ -222,6 +244,7 @@ core::Frame Recording::loadFrame(std::size_t position) const {
     const FrameEntry& entry = frames_.at(position);
     const std::filesystem::path path = framePath(directory_, entry.index);
     core::Frame frame;
+    requirePngOfSize(path, rig_.calibration.cameraSize, "camera size");
     frame.image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
     if (frame.image.empty())
         throw InputError(path.string(), "", "not a readable image");

@@ -166,16 +166,9 @@ void Daemon::drawDisplayThrough(const core::Calibration& calibration) {
 }
 
 std::vector<io::TouchSink*> Daemon::openOutputs() {
+    // The touchscreen first: the desktop waits for it, and what the console and the log show of a frame has
+    // then reached the desktop already.
     std::vector<io::TouchSink*> sinks;
-    // A person at the terminal sees the touches; the journal of a service would only fill up with them.
-    if (!options_.service) {
-        console_ = std::make_unique<io::ConsoleSink>();
-        sinks.push_back(console_.get());
-    }
-    if (!options_.touchLog.empty()) {
-        touchLog_ = std::make_unique<io::TouchLogWriter>(options_.touchLog);
-        sinks.push_back(touchLog_.get());
-    }
     const bool uinputAsked = std::ranges::find(options_.outputs, "uinput") != options_.outputs.end();
     if (uinputAsked || config_.uinput.value_or(cameraRig_)) {
         touchscreen_ = std::make_unique<TouchscreenOutput>([this](const std::string& devnode) {
@@ -192,6 +185,15 @@ std::vector<io::TouchSink*> Daemon::openOutputs() {
                 << "the virtual touchscreen appears once everytouchd is calibrated: its size comes from "
                    "the calibration";
         sinks.push_back(touchscreen_.get());
+    }
+    // A person at the terminal sees the touches; the journal of a service would only fill up with them.
+    if (!options_.service) {
+        console_ = std::make_unique<io::ConsoleSink>();
+        sinks.push_back(console_.get());
+    }
+    if (!options_.touchLog.empty()) {
+        touchLog_ = std::make_unique<io::TouchLogWriter>(options_.touchLog);
+        sinks.push_back(touchLog_.get());
     }
     return sinks;
 }

@@ -621,8 +621,9 @@ TEST(Everytouchd, ReplaysARecordedDragOntoItsTouchscreen) {
     daemon.signal(SIGCONT);
     ASSERT_TRUE(opened) << "libinput debug-events never opened " << devnode;
 
-    // Held again once it has logged the lift, until libinput shows the up: an up that came only with the
-    // device's removal at the end would be a lift the screen missed.
+    // Held again once it has logged the lift (the daemon writes its touchscreen before its log), until
+    // libinput shows the up: an up that came only with the device's removal at the end would be a lift the
+    // screen missed.
     constexpr auto kReplayPatience = 300s;  // 108 frames take 25 s under emulation
     ASSERT_TRUE(
         waitFor([&] { return logsALift(test::fileContents(dir / "touches.jsonl")) || !daemon.running(); },
@@ -780,7 +781,7 @@ std::string interruptMidTouch(Interruption interruption, const test::TempDir& di
                                      dir / (name + ".libinput"));
     EXPECT_TRUE(attached(libinput, devnode)) << "libinput debug-events never opened " << devnode;
     daemon.signal(SIGCONT);
-    // Interrupted once the touch has reached libinput (the touch log, written first, is not enough).
+    // Interrupted once the touch has reached libinput.
     const bool touching = waitFor([&] {
         return test::fileContents(dir / (name + ".libinput")).find("TOUCH_DOWN") != std::string::npos ||
                !daemon.running();

@@ -265,6 +265,38 @@ TEST_F(RecordingTest, FrameOfWrongSizeIsRejectedWhenRead) {
                 ::testing::ThrowsMessage<InputError>(HasSubstr("000001.png")));
 }
 
+// A PNG's first 24 bytes: the signature and an IHDR chunk declaring `width` x `height`, 8-bit gray; no
+// pixels.
+std::string pngHeader(std::uint32_t width, std::uint32_t height) {
+    std::string header("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR", 16);
+    for (std::uint32_t value : {width, height})
+        for (int shift = 24; shift >= 0; shift -= 8)
+            header += static_cast<char>((value >> shift) & 0xff);
+    return header + std::string("\x08\0\0\0\0\0\0\0\0", 9);
+}
+
+TEST_F(RecordingTest, AnImageWhoseHeaderClaimsAnotherSizeIsRefusedBeforeItIsDecoded) {
+    // 40000 x 40000 would be 1.6 GB to allocate before the first pixel.
+    test::writeText(Recording::framePath(dir_.path(), 1), pngHeader(40000, 40000));
+    test::writeText(Recording::maskPath(dir_.path(), 2), pngHeader(40000, 40000));
+    const Recording recording = Recording::open(dir_.path());
+    EXPECT_THAT([&] { recording.loadFrame(1); },
+                ::testing::ThrowsMessage<InputError>(AllOf(
+                    HasSubstr("frames/000001.png"), HasSubstr("camera size 648x488, found 40000x40000"))));
+    EXPECT_THAT(maskComplaint(dir_.path(), 2),
+                AllOf(HasSubstr("masks/000002.png"), HasSubstr("found 40000x40000")));
+}
+
+TEST_F(RecordingTest, AFrameThatIsNoPngIsRefusedEvenWhenItDecodes) {
+    std::vector<uchar> jpeg;
+    ASSERT_TRUE(cv::imencode(".jpg", frames_[2].image, jpeg));
+    test::writeText(Recording::framePath(dir_.path(), 2), std::string(jpeg.begin(), jpeg.end()));
+    const Recording recording = Recording::open(dir_.path());
+    EXPECT_THAT([&] { recording.loadFrame(2); },
+                ::testing::ThrowsMessage<InputError>(
+                    AllOf(HasSubstr("frames/000002.png"), HasSubstr("not a readable PNG image"))));
+}
+
 // A file size limit makes the writes of one frame fail as a full disk would, in this process and without
 // privileges: the frame's image is refused (EFBIG), its truth and mask, written before, are taken back.
 class FileSizeLimit {
