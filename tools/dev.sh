@@ -105,7 +105,7 @@ tsan)
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
     TSAN_OPTIONS="suppressions=$PWD/tests/tsan-suppressions.txt halt_on_error=1" \
         ctest --test-dir build-tsan --output-on-failure -j "$jobs" \
-        -R '^(FrameLoop|FrameQueue|FrameTap|MainLoopInbox|CalibrationJob|CalibrationRunner|SnapshotRequests|DescriptorWriter|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|Everytouchd|EverytouchdConfig|EverytouchdService)' \
+        -R '^(FrameLoop|FrameQueue|FrameTap|CalibrationJob|CalibrationRunner|SnapshotRequests|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|Everytouchd|EverytouchdConfig|EverytouchdService)' \
         -E '^ServiceTest\.ANewUserCalibratesFully' "$@"
     ;;
 fuzz)

@@ -209,7 +209,7 @@ void AravisSource::releaseLostCamera() {
 double AravisSource::stallTimeoutSeconds() const {
     if (!trigger_.empty())
         return kTriggeredStallSeconds;
-    return frameRate_ > 0.0 ? std::max(0.5, 10.0 / frameRate_) : 1.0;
+    return cameraStallSeconds(frameRate_);
 }
 
 std::optional<core::Frame> AravisSource::next() {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -20,6 +21,12 @@ class SourceLost : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
 };
+
+// How long a free-running camera at `frameRate` (0: unknown) may deliver no complete frame before it counts
+// as lost: ten frame periods, at least half a second; a second when the rate is unknown.
+inline double cameraStallSeconds(double frameRate) {
+    return frameRate > 0.0 ? std::max(0.5, 10.0 / frameRate) : 1.0;
+}
 
 // A stream of camera frames: a camera, the simulator or a recording. `next` blocks until the next frame
 // (paced in real time unless the source was asked to run fast) and returns nothing at the end of the stream;

@@ -123,10 +123,6 @@ cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
                              std::to_string(8 * image.elemSize1()) + "-bit with " +
                              std::to_string(image.channels()) +
                              (image.channels() == 1 ? " channel" : " channels"));
-    if (image.size() != size)
-        throw InputError(
-            name, "",
-            "expected the " + sizeName + " " + sizeText(size) + ", found " + sizeText(image.size()));
     const int nonBinary = image.total() - cv::countNonZero(image == 0) - cv::countNonZero(image == 255);
     if (nonBinary != 0)
         throw InputError(
@@ -250,8 +246,6 @@ core::Frame Recording::loadFrame(std::size_t position) const {
         throw InputError(path.string(), "", "not a readable image");
     if (frame.image.type() != CV_8UC1 && frame.image.type() != CV_8UC3)
         throw InputError(path.string(), "", "expected an 8-bit gray or BGR image");
-    if (frame.image.size() != rig_.calibration.cameraSize)
-        throw InputError(path.string(), "", "image size differs from camera_size in rig.yml");
     frame.index = entry.index;
     frame.timestampUs = entry.timestampUs;
     frame.polarity = entry.polarity;
@@ -303,11 +297,16 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const R
 void RecordingWriter::begin(std::uint64_t index) {
     if (openIndex_ == index)
         return;
+    completeOpenFrame();
+    openIndex_ = index;
+}
+
+void RecordingWriter::completeOpenFrame() {
+    openIndex_.reset();
     framesComplete_ = framesSize_;
     truthComplete_ = truthSize_;
     openImages_.clear();
-    openFrames_ = 0;
-    openIndex_ = index;
+    openFrameListed_ = false;
 }
 
 template <typename Write>
@@ -334,8 +333,9 @@ void RecordingWriter::takeBackOpenFrame() noexcept {
         framesSize_ = framesComplete_;
     if (truthCsv_ && ::ftruncate(truthCsv_.get(), truthComplete_) == 0)
         truthSize_ = truthComplete_;
-    framesWritten_ -= openFrames_;
-    openFrames_ = 0;
+    if (openFrameListed_)
+        --framesWritten_;
+    openFrameListed_ = false;
 }
 
 void RecordingWriter::writeImage(const std::filesystem::path& path, const cv::Mat& image) {
@@ -345,24 +345,27 @@ void RecordingWriter::writeImage(const std::filesystem::path& path, const cv::Ma
     if (!file)
         throw std::system_error(errno, std::generic_category(), path.string());
     openImages_.push_back(path);
-    off_t size = 0;
-    appendLine(file, std::string_view(reinterpret_cast<const char*>(encoded_.data()), encoded_.size()), path,
-               size);
+    writeAll(file, std::string_view(reinterpret_cast<const char*>(encoded_.data()), encoded_.size()), path);
     if (::close(file.release()) != 0)
         throw std::system_error(errno, std::generic_category(), path.string());
 }
 
-void RecordingWriter::appendLine(const UniqueFd& table, std::string_view line,
-                                 const std::filesystem::path& path, off_t& size) {
-    while (!line.empty()) {
-        const ssize_t written = ::write(table.get(), line.data(), line.size());
+void RecordingWriter::writeAll(const UniqueFd& file, std::string_view bytes,
+                               const std::filesystem::path& path) {
+    while (!bytes.empty()) {
+        const ssize_t written = ::write(file.get(), bytes.data(), bytes.size());
         if (written < 0 && errno == EINTR)
             continue;
         if (written <= 0)
             throw std::system_error(written < 0 ? errno : ENOSPC, std::generic_category(), path.string());
-        line.remove_prefix(static_cast<std::size_t>(written));
-        size += written;
+        bytes.remove_prefix(static_cast<std::size_t>(written));
     }
+}
+
+void RecordingWriter::appendLine(const UniqueFd& table, std::string_view line,
+                                 const std::filesystem::path& path, off_t& size) {
+    writeAll(table, line, path);
+    size += static_cast<off_t>(line.size());
 }
 
 void RecordingWriter::addFrame(const core::Frame& frame) {
@@ -375,7 +378,7 @@ void RecordingWriter::addFrame(const core::Frame& frame) {
         appendLine(framesCsv_, std::string_view(line, static_cast<std::size_t>(length)),
                    directory_ / "frames.csv", framesSize_);
         ++framesWritten_;
-        openFrames_ = 1;
+        openFrameListed_ = true;
     });
 }
 
@@ -407,11 +410,7 @@ void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
 void RecordingWriter::flush() {
     if (stopped_)
         return;
-    openIndex_.reset();
-    framesComplete_ = framesSize_;
-    truthComplete_ = truthSize_;
-    openImages_.clear();
-    openFrames_ = 0;
+    completeOpenFrame();
     for (const UniqueFd* table : {&framesCsv_, &truthCsv_})
         if (*table && ::fdatasync(table->get()) != 0)
             throw std::system_error(errno, std::generic_category(), directory_.string() + ": the tables");

@@ -82,17 +82,23 @@ public:
 
     // Frames in frames.csv.
     std::uint64_t framesWritten() const { return framesWritten_; }
+    // Whether a write failed: the writer takes nothing more.
+    bool stopped() const { return stopped_; }
 
 private:
     // Starts frame `index` unless it is the one being written: the one before is then complete.
     void begin(std::uint64_t index);
+    // The frame being written is complete: a failure later no longer takes it back.
+    void completeOpenFrame();
     // Runs `write`; when it throws, takes the open frame away and stops the writer.
     template <typename Write>
     void guarded(std::uint64_t index, Write write);
     void takeBackOpenFrame() noexcept;
     void writeImage(const std::filesystem::path& path, const cv::Mat& image);
-    void appendLine(const UniqueFd& table, std::string_view line, const std::filesystem::path& path,
-                    off_t& size);
+    static void writeAll(const UniqueFd& file, std::string_view bytes, const std::filesystem::path& path);
+    // Appends to frames.csv or truth.csv, whose bytes `size` counts.
+    static void appendLine(const UniqueFd& table, std::string_view line, const std::filesystem::path& path,
+                           off_t& size);
 
     std::filesystem::path directory_;
     cv::Size cameraSize_;
@@ -103,7 +109,7 @@ private:
     off_t framesComplete_ = 0, truthComplete_ = 0;   // bytes of the complete frames
     std::optional<std::uint64_t> openIndex_;         // the frame being written
     std::vector<std::filesystem::path> openImages_;  // its files
-    std::uint64_t openFrames_ = 0;                   // 1 once its line is in frames.csv
+    bool openFrameListed_ = false;                   // its line is in frames.csv
     std::uint64_t framesWritten_ = 0;
     bool stopped_ = false;
     std::vector<uchar> encoded_;

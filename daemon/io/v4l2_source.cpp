@@ -259,7 +259,7 @@ void V4l2Source::lose(const std::string& problem) {
 }
 
 double V4l2Source::stallTimeoutSeconds() const {
-    return frameRate_ > 0.0 ? std::max(0.5, 10.0 / frameRate_) : 1.0;
+    return cameraStallSeconds(frameRate_);
 }
 
 std::optional<core::Frame> V4l2Source::next() {

@@ -197,7 +197,7 @@ void FrameLoop::runCamera() {
         if (!queue_.push(std::move(item)))
             break;
     }
-    if (recorder_ && !recordingStopped_) {
+    if (recorder_ && !recorder_->stopped()) {
         try {
             recorder_->flush();
         } catch (const std::exception& error) {
@@ -208,7 +208,7 @@ void FrameLoop::runCamera() {
 }
 
 void FrameLoop::record(const core::Frame& frame) {
-    if (!recorder_ || recordingStopped_)
+    if (!recorder_ || recorder_->stopped())
         return;
     try {
         recorder_->addFrame(frame);
@@ -222,7 +222,6 @@ void FrameLoop::record(const core::Frame& frame) {
 }
 
 void FrameLoop::stopRecording(const std::string& problem) {
-    recordingStopped_ = true;
     const std::string stopped = "the recording stopped: " + problem + "; it keeps the " +
                                 std::to_string(recorder_->framesWritten()) +
                                 " frames before, and detection goes on";

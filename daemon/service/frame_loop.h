@@ -126,7 +126,6 @@ private:
     std::atomic<bool> detecting_{false};
     std::atomic<bool> failingNow_{false};
     std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)
-    bool recordingStopped_ = false;    // camera thread
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
     std::thread pipelineThread_;

@@ -77,6 +77,9 @@ const std::filesystem::path& recordingDirectory() {
         cv::imwrite((path / "pattern.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)));
         everytouch::fuzz::writeFile(path / "rig.yml", kRig);
         everytouch::fuzz::writeFile(path / "frames.csv", "index,timestamp_us,polarity\n0,0,1\n");
+        for (const std::filesystem::path& image :
+             {everytouch::io::Recording::framePath(path, 0), everytouch::io::Recording::maskPath(path, 0)})
+            everytouch::fuzz::writeFile(image, "");
         return path;
     }();
     return directory;
@@ -87,10 +90,11 @@ const std::filesystem::path& recordingDirectory() {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace everytouch;
     const std::filesystem::path& directory = recordingDirectory();
+    // Opened once: its images are read from their files each time one is loaded.
+    static const io::Recording recording = io::Recording::open(directory);
     const std::string_view image(reinterpret_cast<const char*>(data), size);
     fuzz::writeFile(io::Recording::framePath(directory, 0), image);
     fuzz::writeFile(io::Recording::maskPath(directory, 0), image);
-    const io::Recording recording = io::Recording::open(directory);
     try {
         (void)recording.loadFrame(0);
     } catch (const io::InputError&) {
