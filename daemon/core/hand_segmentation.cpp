@@ -169,8 +169,9 @@ HandSegmenter::HandSegmenter(const SegmentationOptions& options)
         throw std::invalid_argument("segmentation options: " + *problem);
 }
 
-void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& pattern) {
-    tableCode_ = predictTableCode(calibration, pattern, options_.cameraBlurPx);
+void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& pattern,
+                           std::optional<double> codeBlurPx) {
+    tableCode_ = predictTableCode(calibration, pattern, codeBlurPx.value_or(options_.cameraBlurPx));
     elevation_.setRig(calibration, pattern);
     evidence_ = CodeEvidence{};
     evidence_.blockPx = options_.blockPx;

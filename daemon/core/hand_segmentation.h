@@ -40,7 +40,7 @@ struct SegmentationOptions {
     int blockPx = 4;
     int windowBlocks = 3;
     // The camera's own blur (Gaussian sigma, camera pixels) on top of its pixels' footprint, for predicting
-    // how it sees the table's code.
+    // how it sees the table's code, until the rig's is measured (core/code_blur.h).
     double cameraBlurPx = 0.5;
     // A finger is this wide (mm); a region narrower than half a finger's area is noise, not a hand.
     double fingerWidthMm = 14.0;
@@ -71,7 +71,10 @@ public:
     explicit HandSegmenter(const SegmentationOptions& options);
 
     // The rig: its calibration and code (pattern CV_8UC1 0/1, projector size). The Code method needs it.
-    void setRig(const Calibration& calibration, const cv::Mat& pattern);
+    // codeBlurPx: the camera blur beyond a pixel's footprint with which the code on the table is predicted
+    // (CodeBlurMeter measures it); nothing: options.cameraBlurPx.
+    void setRig(const Calibration& calibration, const cv::Mat& pattern,
+                std::optional<double> codeBlurPx = std::nullopt);
     bool hasRig() const { return !tableCode_.predicted.empty(); }
     // The table's code as the camera sees it, for the rig set.
     const TableCode& tableCode() const { return tableCode_; }

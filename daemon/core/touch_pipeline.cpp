@@ -25,6 +25,8 @@ bool sameCalibration(const Calibration& a, const Calibration& b) {
 constexpr double kStillWidths = 0.1;
 // A fingertip of this frame is the one of the last frame when it lies within this fraction of its width.
 constexpr double kSameWidths = 0.5;
+// A pair whose S shows no code for the blur to be measured on is followed by this many without a try.
+constexpr int kPairsBetweenBlurMeasurements = 30;
 
 }  // namespace
 
@@ -78,6 +80,9 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
     segmenter_.setRig(calibration, settings.pattern);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
     height_.setRig(calibration, settings.pattern);
+    codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
+    codeBlurMeasured_ = false;
+    pairsUntilBlurMeasure_ = 0;
     const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
     options_.fingertips.fingerWidthPx = rig.fingerWidthPx;
     options_.fingertips.padDrop = rig.padDrop;
@@ -89,6 +94,20 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
     rigCalibration_ = calibration;
     rigPattern_ = settings.pattern;
     reset();
+}
+
+void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings) {
+    if (codeBlurMeasured_ || !codeBlur_.hasRig() || pairsUntilBlurMeasure_-- > 0)
+        return;
+    const std::optional<double> blur = codeBlur_.measure(subtraction);
+    if (!blur) {
+        pairsUntilBlurMeasure_ = kPairsBetweenBlurMeasurements;
+        return;
+    }
+    // Once: a rig's focus does not change while it runs, and a new calibration measures it again.
+    codeBlurMeasured_ = true;
+    segmenter_.setRig(*settings.calibration, settings.pattern, *blur);
+    polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
 }
 
 const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
@@ -124,6 +143,7 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
         ordered = swappedPair(ordered);
         computeSubtractionAndTexture(ordered, result_.subtraction, result_.texture);
     }
+    measureCodeBlur(result_.subtraction, settings);
     result_.framesSwapped = polarityLock_.swapped();
     result_.polaritySwaps = polarityLock_.swaps();
     // The last pair's mask stays in place while a scene without fingertips stands still. Fingertips are found

@@ -9,6 +9,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "core/calibration.h"
+#include "core/code_blur.h"
 #include "core/contact.h"
 #include "core/contact_tracker.h"
 #include "core/fingertips.h"
@@ -116,11 +117,17 @@ private:
     };
 
     void adoptRig(const PipelineSettings& settings);
+    void measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings);
     void measureFingertips(const FramePair& pair, const PipelineSettings& settings);
 
     DetectionOptions options_;
     HandSegmenter segmenter_;
     PolarityLock polarityLock_;
+    // The code's blur on this rig, read from the first pair that shows the code: the segmentation predicts
+    // the table's code with it (core/code_blur.h).
+    CodeBlurMeter codeBlur_;
+    bool codeBlurMeasured_ = false;
+    int pairsUntilBlurMeasure_ = 0;
     StillScene stillScene_;
     SurfaceHeight height_;
     ContactTracker tracker_;

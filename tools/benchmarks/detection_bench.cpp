@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/code_blur.h"
 #include "core/code_image.h"
 #include "core/fingertips.h"
 #include "core/hand_segmentation.h"
@@ -187,6 +188,23 @@ void BM_PolarityCheck(benchmark::State& state) {
     state.counters["correlation"] = lock.correlation();
 }
 BENCHMARK(BM_PolarityCheck)->Unit(benchmark::kMicrosecond);
+
+// The code's blur, read once per rig from the first pair that shows the code.
+void BM_CodeBlur(benchmark::State& state) {
+    cv::setNumThreads(1);
+    const Scene& scene = oneHand();
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::CodeBlurMeter meter;
+    meter.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion());
+    cv::Mat subtraction, texture;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    double blur = 0.0;
+    for (auto _ : state)
+        blur = meter.measure(subtraction).value_or(-1.0);
+    state.counters["blur_px"] = blur;
+}
+BENCHMARK(BM_CodeBlur)->Unit(benchmark::kMillisecond);
 
 void runPipeline(benchmark::State& state, const Scene& scene) {
     cv::setNumThreads(1);

@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "core/code_blur.h"
 #include "core/code_image.h"
 #include "core/frame_pairer.h"
 #include "core/hand_segmentation.h"
@@ -28,14 +29,30 @@ SegmentationMethod pipelineMethod(const io::Recording& recording, core::Segmenta
                                   const std::string& name, const std::string& description) {
     core::SegmentationOptions options;
     options.method = which;
-    auto segmenter = std::make_shared<core::HandSegmenter>(options);
-    segmenter->setRig(recording.rig().calibration, recording.rig().pattern);
+    // As the pipeline does, the code on the table is predicted as blurred as the first pair with code shows
+    // it.
+    struct State {
+        core::HandSegmenter segmenter;
+        core::CodeBlurMeter codeBlur;
+        bool blurMeasured = false;
+    };
+    auto state = std::make_shared<State>(State{core::HandSegmenter(options), {}, false});
+    const core::Calibration& calibration = recording.rig().calibration;
+    const cv::Mat& pattern = recording.rig().pattern;
+    state->segmenter.setRig(calibration, pattern);
+    if (which == core::SegmentationMethod::Code)
+        state->codeBlur.setRig(calibration, pattern, state->segmenter.judgedRegion());
     SegmentationMethod method;
     method.name = name;
     method.description = description;
-    method.judged = segmenter->judgedRegion();
-    method.segment = [segmenter](const SegmentationInput& input, cv::Mat& mask) {
-        segmenter->segment(input.texture, input.subtraction, mask);
+    method.judged = state->segmenter.judgedRegion();
+    method.segment = [state, calibration, pattern](const SegmentationInput& input, cv::Mat& mask) {
+        if (state->codeBlur.hasRig() && !state->blurMeasured)
+            if (const std::optional<double> blur = state->codeBlur.measure(input.subtraction)) {
+                state->segmenter.setRig(calibration, pattern, *blur);
+                state->blurMeasured = true;
+            }
+        state->segmenter.segment(input.texture, input.subtraction, mask);
     };
     return method;
 }
