@@ -200,11 +200,16 @@ double Renderer::meterExposureMs(double ambientLux, const std::vector<Props>& pr
     const cv::Scalar albedo = cv::mean(albedo_);
     const Eigen::Vector3f& ambient = ambientBgr_;
     double dnPerMs = 0.0;
+    // A colour pixel records one channel's light, a monochrome pixel the light of all three.
+    const bool mono = parameters_.cameraColour == CameraColour::Mono;
     const auto meter = [&](const Eigen::Vector3f& reflectance, double projectorLux) {
+        double recorded = 0.0;
         for (int c = 0; c < 3; ++c) {
             const double radiance = reflectance[c] * (projectorLux + ambientLux * ambient[c]);
-            dnPerMs = std::max(dnPerMs, radiance * sensor_.dnPerLux(c, 1.0));
+            const double value = radiance * sensor_.dnPerLux(c, 1.0);
+            recorded = mono ? recorded + value : std::max(recorded, value);
         }
+        dnPerMs = std::max(dnPerMs, recorded);
     };
     meter(Eigen::Vector3f(static_cast<float>(albedo[0]), static_cast<float>(albedo[1]),
                           static_cast<float>(albedo[2])),

@@ -1,6 +1,8 @@
 // Every scenario runs, and its ground truth is consistent with the rendered scene.
 #include "sim/scenario.h"
 
+#include <opencv2/core.hpp>
+
 #include <gtest/gtest.h>
 
 #include "sim/simulator.h"
@@ -170,6 +172,26 @@ TEST(Simulator, MovingHandsAreBlurredOverTheExposureStillOnesAreNot) {
     // Only the fastest moves between circles travel more than a pixel in one exposure.
     EXPECT_GT(moving, 0);
     EXPECT_GT(still, 10 * moving);
+}
+
+// The exposure is metered as each sensor records: a monochrome pixel takes the light of all three colours, so
+// metering its brightest colour alone clipped the whole white display at 255, where no code survives.
+TEST(Simulator, EverySensorIsExposedSoThatTheWhiteTableDoesNotClip) {
+    for (const CameraColour colour : {CameraColour::Bayer, CameraColour::Rgb, CameraColour::Mono}) {
+        SimParameters p;
+        p.scenario = "grid35";
+        p.cameraColour = colour;
+        Simulator simulator(p, test::randomPattern(p.projectorSize, 1));
+        core::Frame frame;
+        FrameTruth truth;
+        simulator.render(0, frame, truth);
+        double brightest = 0.0;
+        cv::minMaxLoc(frame.image.reshape(1), nullptr, &brightest);
+        const double clipped = cv::countNonZero(frame.image.reshape(1) >= 255) /
+                               static_cast<double>(frame.image.total() * frame.image.channels());
+        EXPECT_LT(clipped, 0.001) << "sensor " << static_cast<int>(colour);
+        EXPECT_GT(brightest, 0.6 * 255) << "sensor " << static_cast<int>(colour);
+    }
 }
 
 TEST(Simulator, AmbientLightChangesMidSession) {
