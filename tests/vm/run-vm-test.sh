@@ -9,14 +9,15 @@
 # daemon binary and the rig stay the same.
 #
 # usage: run-vm-test.sh --work DIR --test BINARY --v4l2-test BINARY --daemon BINARY --rules DIR
-#                       --recording-rig sim:SPEC
+#                       --recording-rig sim:SPEC [--gtest-filter FILTER]
+# --gtest-filter: the cases to run in both test binaries (GoogleTest's filter syntax; default all)
 # environment: EVERYTOUCH_VM_CACHE  where the kernel is kept between runs (default: DIR/cache)
 #              EVERYTOUCH_VM_KERNEL_PACKAGE  a linux-image-* package to use instead of linux-image-amd64's
 #              EVERYTOUCH_VM_TIMEOUT  seconds the guest may run (default 600)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 
-work="" test_binary="" v4l2_test_binary="" daemon="" rules="" recording_rig=""
+work="" test_binary="" v4l2_test_binary="" daemon="" rules="" recording_rig="" gtest_filter=""
 while [ $# -gt 0 ]; do
     case "$1" in
     --work) work=$2; shift 2 ;;
@@ -25,6 +26,7 @@ while [ $# -gt 0 ]; do
     --daemon) daemon=$2; shift 2 ;;
     --rules) rules=$2; shift 2 ;;
     --recording-rig) recording_rig=$2; shift 2 ;;
+    --gtest-filter) gtest_filter=$2; shift 2 ;;
     *) echo "run-vm-test.sh: unknown argument $1" >&2; exit 2 ;;
     esac
 done
@@ -188,7 +190,7 @@ set +e
 timeout --foreground -k 5 "${EVERYTOUCH_VM_TIMEOUT:-600}" qemu-system-x86_64 \
     -accel tcg,thread=multi -cpu max -smp 2 -m 1536 \
     -kernel "$kernel_dir/vmlinux" -initrd "$work/initramfs.cpio" \
-    -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init" \
+    -append "console=ttyS0 quiet loglevel=3 panic=-1 rdinit=/init${gtest_filter:+ GTEST_FILTER=$gtest_filter}" \
     -nographic -no-reboot -nodefaults -serial stdio -monitor none </dev/null | tr -d '\r' | tee "$console"
 qemu_status=${PIPESTATUS[0]}
 set -e
