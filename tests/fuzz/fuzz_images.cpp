@@ -4,9 +4,7 @@
 // anything else is a finding, and so is an image that makes the reader allocate far beyond the camera's size
 // (libFuzzer's -rss_limit_mb).
 #include <cstdint>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <filesystem>
 
 #include "fuzz_input.h"
 #include "io/input_error.h"
@@ -71,10 +69,7 @@ constexpr const char* kRig =
 
 const std::filesystem::path& recordingDirectory() {
     static const std::filesystem::path directory = [] {
-        const std::filesystem::path path = everytouch::fuzz::scratchDirectory() / "recording";
-        std::filesystem::create_directories(path / "frames");
-        std::filesystem::create_directories(path / "masks");
-        cv::imwrite((path / "pattern.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)));
+        const std::filesystem::path& path = everytouch::fuzz::recordingSkeleton();
         everytouch::fuzz::writeFile(path / "rig.yml", kRig);
         everytouch::fuzz::writeFile(path / "frames.csv", "index,timestamp_us,polarity\n0,0,1\n");
         for (const std::filesystem::path& image :

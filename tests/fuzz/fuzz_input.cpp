@@ -7,6 +7,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 namespace everytouch::fuzz {
 
 namespace {
@@ -30,6 +33,17 @@ struct Scratch {
 const std::filesystem::path& scratchDirectory() {
     static const Scratch scratch;
     return scratch.path;
+}
+
+const std::filesystem::path& recordingSkeleton() {
+    static const std::filesystem::path directory = [] {
+        const std::filesystem::path path = scratchDirectory() / "recording";
+        std::filesystem::create_directories(path / "frames");
+        std::filesystem::create_directories(path / "masks");
+        cv::imwrite((path / "pattern.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)));
+        return path;
+    }();
+    return directory;
 }
 
 void writeFile(const std::filesystem::path& path, std::string_view bytes) {

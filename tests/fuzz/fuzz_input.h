@@ -15,6 +15,10 @@ namespace everytouch::fuzz {
 // A directory of this process's own, removed at exit.
 const std::filesystem::path& scratchDirectory();
 
+// A recording directory in the scratch directory, made once: frames/, masks/ and a 640 x 480 pattern.png of
+// ones, the projector size of the targets' rig.yml. The targets write the files they fuzz into it.
+const std::filesystem::path& recordingSkeleton();
+
 // Writes the bytes to `path`, replacing what was there.
 void writeFile(const std::filesystem::path& path, std::string_view bytes);
 

@@ -15,9 +15,7 @@ namespace {
 
 const std::filesystem::path& recordingDirectory() {
     static const std::filesystem::path directory = [] {
-        const std::filesystem::path path = everytouch::fuzz::scratchDirectory() / "recording";
-        std::filesystem::create_directories(path / "frames");
-        cv::imwrite((path / "pattern.png").string(), cv::Mat(480, 640, CV_8UC1, cv::Scalar(255)));
+        const std::filesystem::path& path = everytouch::fuzz::recordingSkeleton();
         const cv::Mat frame(488, 648, CV_8UC1, cv::Scalar(128));
         for (std::uint64_t index : {0, 1, 2, 3, 192, 193, 194, 195})
             cv::imwrite(everytouch::io::Recording::framePath(path, index).string(), frame);
