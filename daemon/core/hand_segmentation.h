@@ -71,10 +71,10 @@ public:
     explicit HandSegmenter(const SegmentationOptions& options);
 
     // The rig: its calibration and code (pattern CV_8UC1 0/1, projector size). The Code method needs it.
-    // codeBlurPx: the camera blur beyond a pixel's footprint with which the code on the table is predicted
-    // (CodeBlurMeter measures it); nothing: options.cameraBlurPx.
+    // measuredCodeBlurPx: the blur the rig shows its code with beyond a pixel's footprint (CodeBlurMeter);
+    // the table's code is predicted somewhat sharper than that. Nothing: options.cameraBlurPx.
     void setRig(const Calibration& calibration, const cv::Mat& pattern,
-                std::optional<double> codeBlurPx = std::nullopt);
+                std::optional<double> measuredCodeBlurPx = std::nullopt);
     bool hasRig() const { return !tableCode_.predicted.empty(); }
     // The table's code as the camera sees it, for the rig set.
     const TableCode& tableCode() const { return tableCode_; }

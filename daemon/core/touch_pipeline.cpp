@@ -27,12 +27,6 @@ constexpr double kStillWidths = 0.1;
 constexpr double kSameWidths = 0.5;
 // A pair whose S shows no code for the blur to be measured on is followed by this many without a try.
 constexpr int kPairsBetweenBlurMeasurements = 30;
-// The segmentation predicts the table's code this much sharper than the rig shows it (Gaussian sigma, camera
-// pixels, in quadrature): the last millimetres of a touching fingertip show the table's code shifted by less
-// than a pixel, which a sharper prediction tells from the table better. On the default simulated rig, which
-// shows the code with 0.92 px, that is the 0.5 px the segmentation was developed with; predicted exactly as
-// blurred as seen, ε at touch-down rose there by 0.1-0.35 px (docs/detection.md, "The code's blur").
-constexpr double kPredictionSharperPx = 0.77;
 
 }  // namespace
 
@@ -112,9 +106,7 @@ void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSe
     }
     // Once: a rig's focus does not change while it runs, and a new calibration measures it again.
     codeBlurMeasured_ = true;
-    const double sharper = kPredictionSharperPx * kPredictionSharperPx;
-    segmenter_.setRig(*settings.calibration, settings.pattern,
-                      std::sqrt(std::max(0.0, *blur * *blur - sharper)));
+    segmenter_.setRig(*settings.calibration, settings.pattern, *blur);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
 }
 
