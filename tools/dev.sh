@@ -17,6 +17,7 @@ packages=(
     libcli11-dev nlohmann-json3-dev libinih-dev scdoc mandoc lintian
     dbus systemd udev
     qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils
+    python3
 )
 
 jobs=$(nproc)
