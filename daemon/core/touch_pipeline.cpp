@@ -115,8 +115,16 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     result_.sceneStill = false;
     result_.timestampUs = pair.latest().timestampUs;
     result_.handMask.create(pair.positive.image.size(), CV_8UC1);
-    const auto idle = [&](const char* reason) -> const PipelineResult& {
-        computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
+    const auto idle = [&](const std::string& reason) -> const PipelineResult& {
+        // A pair of frames of two sizes (the camera's changed between them) shows nothing.
+        if (pair.negative.image.size() == pair.positive.image.size()) {
+            computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
+        } else {
+            result_.subtraction.create(pair.positive.image.size(), CV_16SC1);
+            result_.texture.create(pair.positive.image.size(), pair.positive.image.type());
+            result_.subtraction = cv::Scalar::all(0);
+            result_.texture = cv::Scalar::all(0);
+        }
         result_.detecting = false;
         result_.idleReason = reason;
         result_.framesSwapped = false;
@@ -130,9 +138,14 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
         return idle("not calibrated");
     if (settings.pattern.empty())
         return idle("the projected code is not known");
-    if (settings.pattern.size() != settings.calibration->projectorSize ||
-        pair.positive.image.size() != settings.calibration->cameraSize)
-        return idle("the camera or the code does not match the calibration's sizes");
+    if (settings.pattern.size() != settings.calibration->projectorSize)
+        return idle("the code does not match the calibration's projector size");
+    const cv::Size cameraSize = settings.calibration->cameraSize;
+    for (const Frame* frame : {&pair.positive, &pair.negative})
+        if (frame->image.size() != cameraSize)
+            return idle("the camera's frames are " + std::to_string(frame->image.cols) + "x" +
+                        std::to_string(frame->image.rows) + ", the calibration's " +
+                        std::to_string(cameraSize.width) + "x" + std::to_string(cameraSize.height));
     adoptRig(settings);
     result_.detecting = true;
     result_.idleReason.clear();

@@ -39,7 +39,24 @@ SimSource::SimSource(const RigSpec& spec, bool paced) : spec_(spec.toString()), 
     }
 }
 
+bool SimSource::faultAt(std::uint64_t index, std::optional<double> fromS, double forS) const {
+    const double seconds = static_cast<double>(index) / simulator_->parameters().frameRate;
+    return fromS && seconds >= *fromS && seconds < *fromS + forS;
+}
+
 std::optional<core::Frame> SimSource::next() {
+    const sim::SimParameters& parameters = simulator_->parameters();
+    // The frames of a stall never come; the one after it comes at its own time, and a paced camera is silent
+    // for the stall's length even when rendering lags behind real time.
+    if (faultAt(index_, parameters.stallS, parameters.stallDurationS)) {
+        while (faultAt(index_, parameters.stallS, parameters.stallDurationS))
+            ++index_;
+        if (paced_) {
+            std::this_thread::sleep_for(std::chrono::duration<double>(parameters.stallDurationS));
+            start_ = std::chrono::steady_clock::now() -
+                     std::chrono::microseconds(simulator_->frameTimestampUs(index_));
+        }
+    }
     if (const auto end = simulator_->endFrame(); end && index_ >= *end)
         return std::nullopt;
     core::Frame frame;
@@ -49,11 +66,16 @@ std::optional<core::Frame> SimSource::next() {
         simulator_->render(index_, frame, truth_);
         truthDisplaySize_ = simulator_->calibration().displaySize;
     }
+    if (faultAt(index_, parameters.wrongSizeS, parameters.wrongSizeDurationS)) {
+        const cv::Size size = frame.image.size();
+        frame.image =
+            frame.image(cv::Rect(size.width / 4, size.height / 4, size.width / 2, size.height / 2)).clone();
+    }
     truthIndex_ = index_;
     if (paced_) {
-        if (index_ == simulator_->firstFrame())
+        if (!start_)
             start_ = std::chrono::steady_clock::now() - std::chrono::microseconds(frame.timestampUs);
-        std::this_thread::sleep_until(start_ + std::chrono::microseconds(frame.timestampUs));
+        std::this_thread::sleep_until(*start_ + std::chrono::microseconds(frame.timestampUs));
     }
     ++index_;
     return frame;

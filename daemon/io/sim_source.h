@@ -53,12 +53,14 @@ private:
     // projected image and the daemon the keystone. Those go first (betweenFrames): a camera thread rendering
     // back to back would otherwise take the mutex again before a waiting thread wakes up, for seconds.
     std::unique_lock<std::mutex> betweenFrames() const;
+    // Whether frame `index` falls in a camera fault that begins `fromS` into the session and lasts `forS`.
+    bool faultAt(std::uint64_t index, std::optional<double> fromS, double forS) const;
     mutable std::mutex renderMutex_;
     mutable std::condition_variable othersDone_;
     mutable std::atomic<int> othersWaiting_{0};
     bool paced_;
     std::uint64_t index_ = 0;
-    std::chrono::steady_clock::time_point start_;
+    std::optional<std::chrono::steady_clock::time_point> start_;  // when frame 0 would have come, once paced
     sim::FrameTruth truth_;
     std::uint64_t truthIndex_ = 0;
     cv::Size truthDisplaySize_;  // the display the last frame showed

@@ -27,6 +27,9 @@ using Clock = std::chrono::steady_clock;
 // Frames waiting between the camera and the pipeline thread: enough to ride out a slow pair, few enough
 // that a late pipeline works on fresh frames.
 constexpr std::size_t kQueueFrames = 4;
+// A camera that delivers no frame for this long has stalled and its contacts go: 30 frames at 120 Hz, 5 at
+// 20 Hz, far longer than a frame's jitter or a pair that the pipeline is slow on.
+constexpr std::chrono::milliseconds kCameraStall{250};
 // Contacts signals at most this often: enough for a tool that draws them, far below the camera rate.
 constexpr auto kContactsSignalInterval = std::chrono::milliseconds(33);
 constexpr std::uint64_t kStatusIntervalUsec = 5'000'000;
@@ -204,6 +207,8 @@ void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
     loopOptions.queueCapacity = kQueueFrames;
     // Sim and replay running fast can wait for the pipeline; a paced stream behaves like a camera.
     loopOptions.overflow = options_.fast ? FrameQueue::Overflow::Block : FrameQueue::Overflow::DropOldest;
+    if (!options_.fast)
+        loopOptions.stallAfter = kCameraStall;
     pipeline_ = std::make_unique<core::TouchPipeline>();
     loop_ = std::make_unique<FrameLoop>(
         *source_, *pipeline_, std::move(sinks), recorder_.get(), loopOptions, pipelineSettings(),
@@ -285,8 +290,10 @@ DaemonState Daemon::state() const {
         return DaemonState::Failed;
     if (calibration_)
         return DaemonState::Calibrating;
-    // Detection runs on every pair once calibrated with the code known, unless a stage keeps failing.
-    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing() || loop_->sourceLost())
+    // Detection runs on every pair once calibrated with the code known, unless a stage keeps failing, the
+    // camera is gone or stalled, or its frames do not fit the calibration.
+    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing() || loop_->sourceLost() ||
+        loop_->idle())
         return DaemonState::Degraded;
     return DaemonState::Running;
 }

@@ -17,6 +17,8 @@ using Clock = std::chrono::steady_clock;
 constexpr double kSmoothingSeconds = 1.0;
 // The pipeline thread wakes at least this often, so its heartbeat shows it is alive while no frame comes.
 constexpr std::chrono::milliseconds kPipelineWake{100};
+// A camera slower than LoopOptions::stallAfter allows has stalled when silent for this many of its intervals.
+constexpr int kStallIntervals = 8;
 // A lost camera is asked again after this, then after twice as long each time, up to the most.
 constexpr std::chrono::milliseconds kFirstReconnectWait{250};
 constexpr std::chrono::milliseconds kMostReconnectWait{5000};
@@ -161,6 +163,7 @@ void FrameLoop::setSettings(core::PipelineSettings settings) {
     std::lock_guard lock(mutex_);
     settings_ = std::move(settings);
     ++settingsVersion_;
+    judged_ = false;  // what detection made of the last pair says nothing about the next one's settings
 }
 
 void FrameLoop::runCamera() {
@@ -303,27 +306,85 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
     publish(result->frameIndex, result->timestampUs, result->contacts);
 }
 
+void FrameLoop::stalled(Clock::duration silence) {
+    const std::string reason =
+        "the camera has delivered no frame for " +
+        std::to_string(std::chrono::duration_cast<std::chrono::milliseconds>(silence).count()) + " ms";
+    ET_LOG(Warning) << "camera: " << reason << "; every contact is released until frames come again";
+    pipeline_.reset();
+    pairer_.reset();
+    {
+        std::lock_guard lock(mutex_);
+        idleReason_ = reason;
+    }
+    detecting_ = false;
+    judged_ = true;
+    notify_();
+}
+
 void FrameLoop::runPipeline() {
     QueuedFrame item;
     std::uint64_t lastIndex = 0;
     std::int64_t lastTimestampUs = 0;
+    // The last frame's arrival, while the camera is watched for a stall (from its first frame on, not while
+    // lost).
+    Clock::time_point lastArrival{};
+    Clock::duration typicalInterval{};  // between frames' arrivals, averaged over the last few
+    bool watchingForStall = false;
+    bool stalledNow = false;
+    // A camera is stalled when it is silent for stallAfter, or for many of its own intervals when it is
+    // slower than that (a simulated camera under a debugger or the sanitizers).
+    const auto stallLimit = [&] {
+        return std::max<Clock::duration>(*options_.stallAfter, kStallIntervals * typicalInterval);
+    };
     core::PipelineSettings settings;
     std::uint64_t settingsVersion = ~std::uint64_t{0};
     const core::Contacts noContacts;
     try {
         while (!stopping_) {
-            const FrameQueue::PopResult result = queue_.pop(item, kPipelineWake);
-            heartbeatNs_ = Clock::now().time_since_epoch().count();
+            // Woken when the camera would count as stalled, so its contacts go as soon as it does.
+            std::chrono::milliseconds wait = kPipelineWake;
+            if (options_.stallAfter && watchingForStall && !stalledNow)
+                wait = std::clamp(
+                    std::chrono::ceil<std::chrono::milliseconds>(lastArrival + stallLimit() - Clock::now()),
+                    std::chrono::milliseconds(1), kPipelineWake);
+            const FrameQueue::PopResult result = queue_.pop(item, wait);
+            const Clock::time_point now = Clock::now();
+            heartbeatNs_ = now.time_since_epoch().count();
             if (result == FrameQueue::PopResult::Closed)
                 break;
+            if (result == FrameQueue::PopResult::Timeout && options_.stallAfter && watchingForStall &&
+                !stalledNow && now - lastArrival >= stallLimit()) {
+                stalledNow = true;
+                stalled(now - lastArrival);
+                publish(lastIndex, lastTimestampUs, noContacts);
+            }
             if (result == FrameQueue::PopResult::Timeout || stopping_)
                 continue;
             if (item.sourceLost) {
                 pipeline_.reset();
                 pairer_.reset();
                 publish(lastIndex, lastTimestampUs, noContacts);
+                watchingForStall = false;  // a lost camera is not also a stalled one
+                stalledNow = false;
                 continue;
             }
+            if (watchingForStall && !stalledNow) {
+                const Clock::duration interval = item.arrival - lastArrival;
+                typicalInterval = typicalInterval == Clock::duration::zero()
+                                      ? interval
+                                      : typicalInterval + (interval - typicalInterval) / 8;
+            }
+            if (stalledNow) {
+                stalledNow = false;
+                ET_LOG(Notice) << "camera: frames come again after "
+                               << std::chrono::duration_cast<std::chrono::milliseconds>(item.arrival -
+                                                                                        lastArrival)
+                                      .count()
+                               << " ms";
+            }
+            lastArrival = item.arrival;
+            watchingForStall = true;
             lastIndex = item.frame.index;
             lastTimestampUs = item.frame.timestampUs;
             std::optional<core::FramePair> pair = pairer_.push(item.frame);
@@ -342,6 +403,10 @@ void FrameLoop::runPipeline() {
             if (newSettings && onSettings_)
                 onSettings_(settings);
             processPair(*pair, settings);
+            {
+                std::lock_guard lock(mutex_);
+                judged_ = judged_ || settingsVersion == settingsVersion_;
+            }
             const double latencyS = std::chrono::duration<double>(Clock::now() - item.arrival).count();
             std::lock_guard lock(mutex_);
             const double weight =

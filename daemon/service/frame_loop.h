@@ -47,6 +47,9 @@ struct LoopOptions {
     std::uint64_t maxFrames = 0;                                       // stop after N camera frames; 0: never
     std::size_t queueCapacity = 4;                                     // frames waiting between the threads
     FrameQueue::Overflow overflow = FrameQueue::Overflow::DropOldest;  // Block for sources that can wait
+    // A live camera that delivers no frame for this long has stalled: every contact is released and detection
+    // waits for frames. Nothing for sources that can wait (a replay or simulation run fast).
+    std::optional<std::chrono::milliseconds> stallAfter;
 };
 
 // Runs on the pipeline thread when new settings take effect, before the next pair: the place for sinks that
@@ -88,8 +91,12 @@ public:
     std::chrono::steady_clock::time_point heartbeat() const;
 
     void setSettings(core::PipelineSettings settings);
-    // Whether detection ran on the last pair (calibrated, the code known, no failure); why not, when not.
+    // Whether detection ran on the last pair (calibrated, the code known, no failure, frames coming); why
+    // not, when not.
     bool detecting() const { return detecting_; }
+    // Whether detection does not run for a reason the loop has seen (a pair judged, or frames that stopped):
+    // not before the first pair, nor before the first pair with new settings.
+    bool idle() const { return judged_ && !detecting_; }
     // Whether a stage failed on the last pair.
     bool failing() const { return failingNow_; }
     std::string idleReason() const;
@@ -100,6 +107,9 @@ private:
     void runPipeline();
     void publish(std::uint64_t frameIndex, std::int64_t timestampUs, const core::Contacts& contacts);
     void processPair(const core::FramePair& pair, const core::PipelineSettings& settings);
+    // The pipeline thread's side of a camera that stopped delivering: says so once and releases every
+    // contact.
+    void stalled(std::chrono::steady_clock::duration silence);
     void recordPipelineTime(double ms);
     // Adds a frame to the recording; a write that fails stops the recording, never the detection.
     void record(const core::Frame& frame);
@@ -124,6 +134,7 @@ private:
     std::atomic<bool> stopping_{false};
     std::atomic<bool> finished_{false};
     std::atomic<bool> detecting_{false};
+    std::atomic<bool> judged_{false};
     std::atomic<bool> failingNow_{false};
     std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)
     std::atomic<std::int64_t> heartbeatNs_{0};

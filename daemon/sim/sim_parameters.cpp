@@ -29,6 +29,14 @@ std::optional<std::string> SimParameters::validate() const {
         return "duration: must be a positive number of seconds";
     if (content.empty())
         return "content: empty";
+    if (stallS && !nonNegative(*stallS))
+        return "stall: must be a number of seconds >= 0";
+    if (!positive(stallDurationS))
+        return "stall_s: must be a positive number of seconds";
+    if (wrongSizeS && !nonNegative(*wrongSizeS))
+        return "wrong_size: must be a number of seconds >= 0";
+    if (!positive(wrongSizeDurationS))
+        return "wrong_size_s: must be a positive number of seconds";
     if (cameraSize.width < 16 || cameraSize.height < 16)
         return "camera_size: at least 16x16 pixels";
     if (!positive(cameraFocalMm))

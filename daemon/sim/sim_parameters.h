@@ -36,6 +36,11 @@ struct SimParameters {
     double startS = 0.0;              // the stream starts this many seconds into the session
     std::optional<double> durationS;  // the stream ends after this many seconds; endless when not set
     std::string content = "auto";     // procedural content kind (see content.h) or "auto": the scenario's own
+    // --- camera faults (what SimSource delivers; the session goes on meanwhile) ---
+    std::optional<double> stallS;  // no frame comes from this session time on, for stallDurationS
+    double stallDurationS = 1.0;
+    std::optional<double> wrongSizeS;  // from this session time the frames are the sensor's centre quarter
+    double wrongSizeDurationS = 0.5;   // (a region changed by someone else), for this long
 
     // --- geometry ---
     cv::Size cameraSize{648, 488};                         // sensor, pixels

@@ -1183,6 +1183,67 @@ TEST_F(ServiceTest, TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem) {
     EXPECT_EQ(unlogged, "") << "lines whose contacts the touch log does not hold";
 }
 
+// grid35's first three taps touch from 1.70 to 2.08 s, 4.68 to 5.02 s and 6.17 to 6.48 s into the session.
+TEST_F(ServiceTest, ACameraThatStallsOrChangesItsFramesSizeReleasesEveryContactUntilItsFramesFitAgain) {
+    constexpr double kFrameRate = 120.0;
+    constexpr double kStallS = 1.85, kStallForS = 1.5, kWrongSizeS = 4.8, kWrongSizeForS = 0.5;
+    startDaemonOn(
+        std::string(kTappingRig) + ",stall=1.85,stall_s=1.5,wrong_size=4.8,wrong_size_s=0.5,duration=6.3",
+        {"--log", (dir_ / "touches.jsonl").string()});
+    const auto waitForReason = [this](const std::string& text) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (test::runProcess(property("get-property", "StateReason")).out.find(text) != std::string::npos)
+                return get("State") == "s \"degraded\"\n";
+            std::this_thread::sleep_for(20ms);
+        }
+        return false;
+    };
+    EXPECT_TRUE(waitForReason("the camera has delivered no frame for")) << daemon_->output();
+    EXPECT_TRUE(waitForProperty("State", "s \"running\""));
+    // (busctl escapes the apostrophe of "the camera's frames")
+    EXPECT_TRUE(waitForReason("frames are 324x244, the calibration")) << daemon_->output();
+    EXPECT_TRUE(waitForProperty("State", "s \"running\""));
+    // The stream ends mid-touch: the daemon ends, its contacts released.
+    ASSERT_EQ(daemon_->wait(kExitTimeout), 0) << daemon_->output();
+    EXPECT_THAT(daemon_->output(), HasSubstr("every contact is released until frames come again"));
+    EXPECT_THAT(daemon_->output(), HasSubstr("camera: frames come again after"));
+
+    const std::vector<io::TouchLogEntry> log = io::readTouchLog(dir_ / "touches.jsonl");
+    ASSERT_FALSE(log.empty());
+    EXPECT_TRUE(log.back().contacts.empty());
+    const auto touching = [](const io::TouchLogEntry& entry) {
+        return std::any_of(entry.contacts.begin(), entry.contacts.end(),
+                           [](const core::Contact& contact) { return contact.touching; });
+    };
+    const auto firstFrom = [&](double seconds) {
+        return std::find_if(log.begin(), log.end(), [&](const io::TouchLogEntry& entry) {
+            return static_cast<double>(entry.index) >= seconds * kFrameRate - 1e-6;
+        });
+    };
+    // The finger touching when the camera stalls is released in the last frame before the stall (a second
+    // entry for that frame), and nothing is reported until frames come again.
+    const auto afterStall = firstFrom(kStallS + 1e-3);
+    ASSERT_GE(afterStall - log.begin(), 2);
+    const io::TouchLogEntry& release = *(afterStall - 1);
+    EXPECT_TRUE(release.contacts.empty());
+    EXPECT_TRUE(touching(*(afterStall - 2)));
+    EXPECT_EQ((afterStall - 2)->index, release.index);
+    ASSERT_NE(afterStall, log.end());
+    EXPECT_GE(static_cast<double>(afterStall->index), (kStallS + kStallForS) * kFrameRate - 1e-6);
+    // The finger touching when the frames change their size is released in the first pair that has one,
+    // and nothing is reported while they have it.
+    const auto atWrongSize = firstFrom(kWrongSizeS);
+    ASSERT_NE(atWrongSize, log.begin());
+    ASSERT_NE(atWrongSize, log.end());
+    EXPECT_TRUE(touching(*(atWrongSize - 1)));
+    EXPECT_TRUE(atWrongSize->contacts.empty());
+    EXPECT_LT(static_cast<double>(atWrongSize->index), kWrongSizeS * kFrameRate + 3.0);
+    const auto afterWrongSize = std::next(atWrongSize);
+    ASSERT_NE(afterWrongSize, log.end());
+    EXPECT_GE(static_cast<double>(afterWrongSize->index), (kWrongSizeS + kWrongSizeForS) * kFrameRate - 1.0);
+}
+
 TEST_F(ServiceTest, TheMonitorEndsAfterItsDurationAndOnSigintOrSigterm) {
     startDaemonOn(kTappingRig);
     const auto started = std::chrono::steady_clock::now();

@@ -1,4 +1,5 @@
 // The whole pipeline on rendered frames: what a user feels of a drag.
+#include <algorithm>
 #include <set>
 
 #include <opencv2/core.hpp>
@@ -120,6 +121,62 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     // were still); a hand that moves in keeps every pair changed but for its pauses (2 of 83).
     EXPECT_GE(stillEmptyPairs, emptyPairs / 2);
     EXPECT_LE(stillHandPairs, handPairs / 10);
+}
+
+TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
+    // Someone changes the camera's region while a finger touches: the pair that mixes the two sizes and the
+    // pairs after it detect nothing and say why; the calibration's size back, detection goes on.
+    sim::SimParameters parameters;
+    parameters.scenario = "grid35";
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    TouchPipeline pipeline;
+    PipelineSettings settings;
+    settings.calibration = simulator.calibration();
+    settings.pattern = simulator.pattern();
+    settings.touchHeightMm = 3.0;
+    const auto centreQuarter = [](const Frame& frame) {
+        Frame cropped = frame;
+        const cv::Size size = frame.image.size();
+        cropped.image =
+            frame.image(cv::Rect(size.width / 4, size.height / 4, size.width / 2, size.height / 2));
+        return cropped;
+    };
+    const auto process = [&](const Frame& older, const Frame& newer) -> const PipelineResult& {
+        const bool olderPositive = older.polarity == Polarity::Positive;
+        return pipeline.process(FramePair{olderPositive ? older : newer, olderPositive ? newer : older},
+                                settings);
+    };
+    const auto touching = [](const PipelineResult& result) {
+        return std::any_of(result.contacts.begin(), result.contacts.end(),
+                           [](const Contact& contact) { return contact.touching; });
+    };
+
+    Frame older, newer;
+    sim::FrameTruth truth;
+    simulator.render(0, older, truth);
+    std::uint64_t index = 1;
+    for (; index < 1200; ++index) {
+        simulator.render(index, newer, truth);
+        const bool touched = touching(process(older, newer));
+        std::swap(older, newer);
+        if (touched)
+            break;
+    }
+    ASSERT_LT(index, 1200u) << "no touch in grid35's first 10 s";
+
+    simulator.render(++index, newer, truth);
+    const Frame smaller = centreQuarter(newer);
+    const PipelineResult& mixed = process(older, smaller);
+    EXPECT_FALSE(mixed.detecting);
+    EXPECT_TRUE(mixed.contacts.empty());
+    simulator.render(++index, older, truth);
+    const PipelineResult& bothSmaller = process(smaller, centreQuarter(older));
+    EXPECT_FALSE(bothSmaller.detecting);
+    EXPECT_TRUE(bothSmaller.contacts.empty());
+    EXPECT_EQ(bothSmaller.idleReason, "the camera's frames are 324x244, the calibration's 648x488");
+
+    simulator.render(++index, newer, truth);
+    EXPECT_TRUE(process(older, newer).detecting);
 }
 
 }  // namespace

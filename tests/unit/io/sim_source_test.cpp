@@ -156,7 +156,28 @@ TEST(SimSource, ShowsAnImageFileAsContent) {
     EXPECT_GT(mean[2], 2.0 * mean[1]);
 }
 
+TEST(SimSource, AStalledCameraSkipsItsFramesAndAResizedOneDeliversItsCentreQuarter) {
+    // At 120 Hz: frames 0-5 come, 6-11 (0.05-0.1 s) never do, 12-17 come; 18-20 have the wrong size.
+    SimSource source(
+        RigSpec::parse("sim:grid35,seed=4,duration=0.175,stall=0.05,stall_s=0.05,wrong_size=0.15,"
+                       "wrong_size_s=0.025"),
+        false);
+    std::vector<std::uint64_t> indices;
+    std::vector<std::uint64_t> smaller;
+    while (const std::optional<core::Frame> frame = source.next()) {
+        indices.push_back(frame->index);
+        if (frame->image.size() != cv::Size(648, 488)) {
+            EXPECT_EQ(frame->image.size(), cv::Size(324, 244));
+            smaller.push_back(frame->index);
+        }
+    }
+    EXPECT_EQ(indices, (std::vector<std::uint64_t>{0, 1, 2, 3, 4, 5, 12, 13, 14, 15, 16, 17, 18, 19, 20}));
+    EXPECT_EQ(smaller, (std::vector<std::uint64_t>{18, 19, 20}));
+}
+
 TEST(SimSource, BadSpecsAreInputErrorsNamingTheKey) {
+    EXPECT_THAT(errorOf("sim:demo,stall=-1"), HasSubstr("stall: must be a number of seconds >= 0"));
+    EXPECT_THAT(errorOf("sim:demo,wrong_size_s=0"), HasSubstr("wrong_size_s: must be a positive number"));
     EXPECT_THAT(errorOf("sim:juggle"), HasSubstr("unknown scenario \"juggle\""));
     EXPECT_THAT(errorOf("sim:demo,noise=3"), HasSubstr("--rig sim:demo,noise=3: noise: unknown key"));
     EXPECT_THAT(errorOf("sim:demo,seed=x"), HasSubstr("seed: expected a non-negative integer"));

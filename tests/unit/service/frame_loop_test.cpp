@@ -149,6 +149,35 @@ private:
     int absences_ = 0;
 };
 
+// A camera that stops delivering after frame 6, without an error, until `resume` is called.
+class StallingSource final : public io::FrameSource {
+public:
+    explicit StallingSource(const std::filesystem::path& recording) : recording_(recording, false) {}
+
+    std::optional<core::Frame> next() override {
+        if (delivered_++ == 7) {
+            std::unique_lock lock(mutex_);
+            resumed_.wait(lock, [this] { return resume_; });
+        }
+        return recording_.next();
+    }
+    std::optional<io::RigDescription> rig() const override { return recording_.rig(); }
+    std::string describe() const override { return "a stalling " + recording_.describe(); }
+
+    void resume() {
+        std::lock_guard lock(mutex_);
+        resume_ = true;
+        resumed_.notify_all();
+    }
+
+private:
+    io::ReplaySource recording_;
+    int delivered_ = 0;
+    std::mutex mutex_;
+    std::condition_variable resumed_;
+    bool resume_ = false;
+};
+
 class FrameLoopTest : public ::testing::Test {
 protected:
     void SetUp() override { test::writeCodedRecording(dir_ / "recording", test::smallRig(), 20, 8333); }
@@ -241,6 +270,38 @@ TEST_F(FrameLoopTest, ALostCameraReleasesEveryContactAndIsWaitedFor) {
     const std::vector<std::uint64_t> touched = sink.touchedIn();
     EXPECT_EQ(std::count(touched.begin(), touched.end(), 6u), 1);
     EXPECT_EQ(touched.back(), 19u);  // touching again once frames came back
+}
+
+TEST_F(FrameLoopTest, AStalledCameraReleasesEveryContactAndDetectionWaitsForItsFrames) {
+    StallingSource source(dir_ / "recording");
+    pipeline_.touchFrom = 2;
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    options.stallAfter = 50ms;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    const auto start = std::chrono::steady_clock::now();
+    loop.start();
+    // Frame 6's contact goes (a second report at frame 6, with no contact) while the camera says nothing.
+    ASSERT_TRUE(notifications_.waitUntil(
+        [&] {
+            const std::vector<std::uint64_t> indices = sink.indices();
+            return std::count(indices.begin(), indices.end(), 6u) == 2;
+        },
+        30s));
+    EXPECT_GE(std::chrono::steady_clock::now() - start, 50ms);
+    EXPECT_TRUE(sink.lastWasEmpty());
+    EXPECT_FALSE(loop.detecting());
+    EXPECT_THAT(loop.idleReason(), HasSubstr("the camera has delivered no frame for"));
+    EXPECT_FALSE(loop.finished());
+    source.resume();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    EXPECT_FALSE(loop.failure());
+    EXPECT_EQ(loop.statistics().frames, 20u);
+    const std::vector<std::uint64_t> touched = sink.touchedIn();
+    EXPECT_EQ(std::count(touched.begin(), touched.end(), 6u), 1);
+    EXPECT_EQ(touched.back(), 19u);  // detecting and touching again once frames came back
+    EXPECT_EQ(std::count(touched.begin(), touched.end(), 7u), 0);  // frame 7 is only the first of a new pair
 }
 
 TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
