@@ -814,13 +814,13 @@ TEST_F(ServiceTest, SurvivesClientsThatDisconnectMidCall) {
     EXPECT_TRUE(daemon_->running());
 }
 
-// How a flood of Snapshot calls was answered.
-struct SnapshotReplies {
+// How a flood of calls was answered.
+struct FloodReplies {
     int answered = 0, busy = 0, ioError = 0, succeeded = 0;
     std::string others;
 
     static int onReply(sd_bus_message* reply, void* userdata, sd_bus_error*) {
-        auto* replies = static_cast<SnapshotReplies*>(userdata);
+        auto* replies = static_cast<FloodReplies*>(userdata);
         ++replies->answered;
         if (sd_bus_message_is_method_error(reply, bus::kErrorBusy))
             ++replies->busy;
@@ -854,7 +854,7 @@ TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
     const io::Bus client(raw);
     constexpr int kCalls = 40;
     std::vector<io::UniqueFd> readEnds, writeEnds;
-    SnapshotReplies replies;
+    FloodReplies replies;
     for (int i = 0; i < kCalls; ++i) {
         int ends[2];
         ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
@@ -865,10 +865,10 @@ TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
         const std::string page(4096, 'x');
         while (::write(ends[1], page.data(), page.size()) > 0) {
         }
-        ASSERT_GE(sd_bus_call_method_async(client.get(), nullptr, bus::kBusName, bus::kObjectPath,
-                                           bus::kInterface, "Snapshot", SnapshotReplies::onReply, &replies,
-                                           "sh", "overlay", ends[1]),
-                  0);
+        ASSERT_GE(
+            sd_bus_call_method_async(client.get(), nullptr, bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                     "Snapshot", FloodReplies::onReply, &replies, "sh", "overlay", ends[1]),
+            0);
     }
     const auto waitForReplies = [&](int count, std::chrono::milliseconds within) {
         const auto until = std::chrono::steady_clock::now() + within;
@@ -890,6 +890,53 @@ TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
     const test::ProcessResult snapshot =
         test::runProcess({EVERYTOUCH_CALIB_PATH, "snapshot", "camera", (dir_ / "after.png").string()});
     EXPECT_EQ(snapshot.exitCode, 0) << snapshot.err;
+    EXPECT_TRUE(daemon_->running());
+}
+
+TEST_F(ServiceTest, AClientThatFloodsCalibrateGetsBusyAndTheFramesGoOn) {
+    startDaemon({}, {}, CalibrationSceneRecording::path());
+    const auto frameRate = [this] {
+        double perSecond = 0.0;
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &perSecond);
+        return perSecond;
+    };
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline && frameRate() < 8.0)
+        std::this_thread::sleep_for(100ms);
+    ASSERT_GT(frameRate(), 8.0);  // the recording runs at 10 frames/s
+
+    // 40 calls at once: the first starts a calibration (100 pairs, 10 s), every other is refused at once.
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus client(raw);
+    constexpr int kCalls = 40;
+    FloodReplies replies;
+    for (int i = 0; i < kCalls; ++i) {
+        sd_bus_message* message = nullptr;
+        ASSERT_GE(sd_bus_message_new_method_call(client.get(), &message, bus::kBusName, bus::kObjectPath,
+                                                 bus::kInterface, "Calibrate"),
+                  0);
+        const io::BusMessage call(message);
+        ASSERT_GE(sd_bus_message_append(call.get(), "s", "table"), 0);
+        ASSERT_GE(sd_bus_message_append(call.get(), "a{sv}", 1, "frames", "u", 100u), 0);
+        ASSERT_GE(sd_bus_call_async(client.get(), nullptr, call.get(), FloodReplies::onReply, &replies, 0),
+                  0);
+    }
+    const auto until = std::chrono::steady_clock::now() + 5s;
+    while (replies.answered < kCalls && std::chrono::steady_clock::now() < until) {
+        if (sd_bus_process(client.get(), nullptr) > 0)
+            continue;
+        sd_bus_wait(client.get(), 100'000);
+    }
+    EXPECT_EQ(replies.answered, kCalls);
+    EXPECT_EQ(replies.succeeded, 1);
+    EXPECT_EQ(replies.busy, kCalls - 1);
+    EXPECT_EQ(replies.others, "");
+    EXPECT_EQ(get("State"), "s \"calibrating\"\n");
+    // Meanwhile the frames go on, and the one calibration ends as it would have alone.
+    EXPECT_GT(frameRate(), 8.0);
+    EXPECT_TRUE(waitForLog("calibrated; RMS reprojection error")) << daemon_->output();
+    EXPECT_TRUE(waitForProperty("State", "s \"running\""));
     EXPECT_TRUE(daemon_->running());
 }
 
