@@ -212,7 +212,7 @@ double AravisSource::stallTimeoutSeconds() const {
     return cameraStallSeconds(frameRate_);
 }
 
-std::optional<core::Frame> AravisSource::next() {
+std::optional<core::Frame> AravisSource::read(cv::Mat spare) {
     if (!stream_) {
         try {
             connect();
@@ -248,6 +248,7 @@ std::optional<core::Frame> AravisSource::next() {
         }
 
         core::Frame frame;
+        frame.image = spare;
         convertCameraPixels(static_cast<const std::uint8_t*>(data), size, pixels_, frame.image);
         const guint64 cameraNs = arv_buffer_get_timestamp(buffer);
         const guint64 hostNs = arv_buffer_get_system_timestamp(buffer);

@@ -37,7 +37,6 @@ public:
 
     // Throws SourceLost when no complete frame came for stallTimeoutSeconds(), and in each later call until
     // the camera answers again with its settings.
-    std::optional<core::Frame> next() override;
     // A camera describes only itself: the calibration store and the projector side know the rest.
     std::optional<RigDescription> rig() const override { return std::nullopt; }
     std::string describe() const override { return description_; }
@@ -48,6 +47,8 @@ public:
     double stallTimeoutSeconds() const;
 
 private:
+    std::optional<core::Frame> read(cv::Mat spare) override;
+
     // Opens the camera, applies the settings and starts it; throws as the constructor does.
     void connect();
     // Lets go of a camera that stopped delivering, without waiting for it.

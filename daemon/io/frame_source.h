@@ -35,7 +35,10 @@ class FrameSource {
 public:
     virtual ~FrameSource() = default;
 
-    virtual std::optional<core::Frame> next() = 0;
+    // `spare`: the image of a frame the caller is done with; the new frame is written into its memory when
+    // the size and type fit (the frame loop gives such buffers back, so that a steady stream allocates no
+    // frame memory). Empty: the source allocates.
+    std::optional<core::Frame> next(cv::Mat spare = cv::Mat()) { return read(std::move(spare)); }
 
     // The rig's own description when the source knows it (simulator, recording); cameras rely on the
     // calibration store instead.
@@ -56,6 +59,10 @@ public:
     // frame. It may share its pixels with the source, so it holds only until the next call of `next`.
     // Nothing for sources without masks.
     virtual std::optional<cv::Mat> truthMask() const { return std::nullopt; }
+
+private:
+    // What next() does; `spare` as there.
+    virtual std::optional<core::Frame> read(cv::Mat spare) = 0;
 };
 
 }  // namespace everytouch::io

@@ -7,7 +7,8 @@ namespace everytouch::io {
 ReplaySource::ReplaySource(const std::filesystem::path& directory, bool paced)
     : directory_(directory), recording_(Recording::open(directory)), paced_(paced) {}
 
-std::optional<core::Frame> ReplaySource::next() {
+// A recording's frames are decoded into images of their own: no spare memory is used.
+std::optional<core::Frame> ReplaySource::read(cv::Mat /*spare*/) {
     if (position_ >= recording_.frames().size())
         return std::nullopt;
     core::Frame frame = recording_.loadFrame(position_);

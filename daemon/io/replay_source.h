@@ -14,7 +14,6 @@ class ReplaySource final : public FrameSource {
 public:
     ReplaySource(const std::filesystem::path& directory, bool paced);
 
-    std::optional<core::Frame> next() override;
     std::optional<RigDescription> rig() const override { return recording_.rig(); }
     std::string describe() const override { return "replay of " + directory_.string(); }
     // Read from the recording on each call, so a replay nobody asks for masks reads none.
@@ -23,6 +22,8 @@ public:
     const Recording& recording() const { return recording_; }
 
 private:
+    std::optional<core::Frame> read(cv::Mat spare) override;
+
     std::filesystem::path directory_;
     Recording recording_;
     bool paced_;

@@ -44,7 +44,7 @@ bool SimSource::faultAt(std::uint64_t index, std::optional<double> fromS, double
     return fromS && seconds >= *fromS && seconds < *fromS + forS;
 }
 
-std::optional<core::Frame> SimSource::next() {
+std::optional<core::Frame> SimSource::read(cv::Mat spare) {
     const sim::SimParameters& parameters = simulator_->parameters();
     // The frames of a stall never come; the one after it comes at its own time, and a paced camera is silent
     // for the stall's length even when rendering lags behind real time.
@@ -60,6 +60,7 @@ std::optional<core::Frame> SimSource::next() {
     if (const auto end = simulator_->endFrame(); end && index_ >= *end)
         return std::nullopt;
     core::Frame frame;
+    frame.image = std::move(spare);
     {
         std::unique_lock lock(renderMutex_);
         othersDone_.wait(lock, [this] { return othersWaiting_ == 0; });

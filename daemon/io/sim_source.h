@@ -24,7 +24,6 @@ public:
     // unreadable content image).
     SimSource(const RigSpec& spec, bool paced);
 
-    std::optional<core::Frame> next() override;
     std::optional<RigDescription> rig() const override;
     std::string describe() const override;
     // Without duration= the stream has no end.
@@ -47,6 +46,8 @@ public:
     void setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector);
 
 private:
+    std::optional<core::Frame> read(cv::Mat spare) override;
+
     std::string spec_;
     std::unique_ptr<sim::Simulator> simulator_;
     // The renderer, for one thread at a time: the camera thread renders while the calibration changes the

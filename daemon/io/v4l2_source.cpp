@@ -262,7 +262,7 @@ double V4l2Source::stallTimeoutSeconds() const {
     return cameraStallSeconds(frameRate_);
 }
 
-std::optional<core::Frame> V4l2Source::next() {
+std::optional<core::Frame> V4l2Source::read(cv::Mat spare) {
     if (!fd_) {
         try {
             connect();
@@ -295,6 +295,7 @@ std::optional<core::Frame> V4l2Source::next() {
             lose(description_ + ": the driver returned a buffer it never gave");
 
         core::Frame frame;
+        frame.image = spare;
         const MemoryMapping& mapping = buffers_[buffer.index];
         const bool complete =
             !(buffer.flags & V4L2_BUF_FLAG_ERROR) && buffer.bytesused <= mapping.length() &&

@@ -31,7 +31,6 @@ public:
 
     // Throws SourceLost when the camera went away or no frame came for stallTimeoutSeconds(), and in each
     // later call until the node opens again with its settings.
-    std::optional<core::Frame> next() override;
     std::optional<RigDescription> rig() const override { return std::nullopt; }
     std::string describe() const override { return description_; }
     std::uint64_t droppedFrames() const override { return dropped_.load(); }
@@ -41,6 +40,8 @@ public:
     double stallTimeoutSeconds() const;
 
 private:
+    std::optional<core::Frame> read(cv::Mat spare) override;
+
     // Opens the node, applies the settings and starts streaming; throws as the constructor does.
     void connect();
     void release();

@@ -44,6 +44,9 @@ FrameLoop::FrameLoop(io::FrameSource& source, core::PairPipeline& pipeline, std:
       notify_(std::move(notify)),
       onSettings_(std::move(onSettings)),
       queue_(options.queueCapacity, options.overflow),
+      // Every frame that can be held at once: those queued, the one paired with the next, and one being
+      // filled.
+      spareFrames_(options.queueCapacity + 2),
       settings_(std::move(settings)),
       pipelineMs_(kPipelineSamples, 0.0) {}
 
@@ -176,7 +179,7 @@ void FrameLoop::runCamera() {
         }
         QueuedFrame item;
         try {
-            std::optional<core::Frame> frame = source_.next();
+            std::optional<core::Frame> frame = source_.next(spareFrames_.take());
             if (!frame)
                 break;
             sourceBack();
@@ -403,6 +406,10 @@ void FrameLoop::runPipeline() {
             if (newSettings && onSettings_)
                 onSettings_(settings);
             processPair(*pair, settings);
+            // The older frame is paired no more; its memory takes a later frame.
+            core::Frame& older =
+                pair->positive.index < pair->negative.index ? pair->positive : pair->negative;
+            spareFrames_.giveBack(std::move(older.image));
             {
                 std::lock_guard lock(mutex_);
                 judged_ = judged_ || settingsVersion == settingsVersion_;

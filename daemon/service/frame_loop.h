@@ -19,6 +19,7 @@
 #include "io/recording.h"
 #include "io/touch_sink.h"
 #include "service/arrival_rate.h"
+#include "service/frame_pool.h"
 #include "service/frame_queue.h"
 #include "service/frame_tap.h"
 
@@ -128,6 +129,7 @@ private:
     std::function<void()> notify_;
     SettingsHook onSettings_;
     FrameQueue queue_;
+    FramePool spareFrames_;  // images the pipeline thread is done with, for the camera thread to fill again
     FrameTap tap_;
     core::FramePairer pairer_;  // pipeline thread only
 

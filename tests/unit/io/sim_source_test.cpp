@@ -175,6 +175,17 @@ TEST(SimSource, AStalledCameraSkipsItsFramesAndAResizedOneDeliversItsCentreQuart
     EXPECT_EQ(smaller, (std::vector<std::uint64_t>{18, 19, 20}));
 }
 
+TEST(SimSource, WritesAFrameIntoTheMemoryItIsOffered) {
+    SimSource source(RigSpec::parse("sim:grid35,seed=4,duration=0.05"), false);
+    std::optional<core::Frame> first = source.next();
+    ASSERT_TRUE(first);
+    const uchar* memory = first->image.data;
+    const std::optional<core::Frame> second = source.next(std::move(first->image));
+    ASSERT_TRUE(second);
+    EXPECT_EQ(second->image.data, memory);
+    EXPECT_EQ(second->index, 1u);
+}
+
 TEST(SimSource, BadSpecsAreInputErrorsNamingTheKey) {
     EXPECT_THAT(errorOf("sim:demo,stall=-1"), HasSubstr("stall: must be a number of seconds >= 0"));
     EXPECT_THAT(errorOf("sim:demo,wrong_size_s=0"), HasSubstr("wrong_size_s: must be a positive number"));

@@ -110,7 +110,7 @@ class LossySource final : public io::FrameSource {
 public:
     explicit LossySource(const std::filesystem::path& recording) : recording_(recording, false) {}
 
-    std::optional<core::Frame> next() override {
+    std::optional<core::Frame> read(cv::Mat) override {
         while (std::optional<core::Frame> frame = recording_.next()) {
             if (frame->index % 3 != 2)
                 return frame;
@@ -132,7 +132,7 @@ class AbsentForAWhileSource final : public io::FrameSource {
 public:
     explicit AbsentForAWhileSource(const std::filesystem::path& recording) : recording_(recording, false) {}
 
-    std::optional<core::Frame> next() override {
+    std::optional<core::Frame> read(cv::Mat) override {
         if (delivered_ == 7 && absences_ < 2) {
             ++absences_;
             throw io::SourceLost("the camera does not answer");
@@ -154,7 +154,7 @@ class StallingSource final : public io::FrameSource {
 public:
     explicit StallingSource(const std::filesystem::path& recording) : recording_(recording, false) {}
 
-    std::optional<core::Frame> next() override {
+    std::optional<core::Frame> read(cv::Mat) override {
         if (delivered_++ == 7) {
             std::unique_lock lock(mutex_);
             resumed_.wait(lock, [this] { return resume_; });
@@ -176,6 +176,33 @@ private:
     std::mutex mutex_;
     std::condition_variable resumed_;
     bool resume_ = false;
+};
+
+// A camera that writes each frame into the memory it is offered, and counts how often that was.
+class SpareWitnessSource final : public io::FrameSource {
+public:
+    explicit SpareWitnessSource(const std::filesystem::path& recording) : recording_(recording, false) {}
+
+    std::optional<core::Frame> read(cv::Mat spare) override {
+        std::optional<core::Frame> frame = recording_.next();
+        if (frame && !spare.empty()) {
+            const uchar* memory = spare.data;
+            frame->image.copyTo(spare);
+            offered_ += 1;
+            written_ += spare.data == memory ? 1 : 0;
+            frame->image = spare;
+        }
+        return frame;
+    }
+    std::optional<io::RigDescription> rig() const override { return recording_.rig(); }
+    std::string describe() const override { return recording_.describe(); }
+    int offered() const { return offered_; }
+    int written() const { return written_; }
+
+private:
+    io::ReplaySource recording_;
+    std::atomic<int> offered_{0};
+    std::atomic<int> written_{0};
 };
 
 class FrameLoopTest : public ::testing::Test {
@@ -302,6 +329,20 @@ TEST_F(FrameLoopTest, AStalledCameraReleasesEveryContactAndDetectionWaitsForItsF
     EXPECT_EQ(std::count(touched.begin(), touched.end(), 6u), 1);
     EXPECT_EQ(touched.back(), 19u);  // detecting and touching again once frames came back
     EXPECT_EQ(std::count(touched.begin(), touched.end(), 7u), 0);  // frame 7 is only the first of a new pair
+}
+
+TEST_F(FrameLoopTest, TheCameraWritesFramesIntoTheMemoryOfFramesThePipelineIsDoneWith) {
+    SpareWitnessSource source(dir_ / "recording");
+    CollectingSink sink;
+    LoopOptions options;
+    options.overflow = FrameQueue::Overflow::Block;
+    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
+    loop.start();
+    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
+    EXPECT_EQ(loop.statistics().pairs, 19u);
+    // The first frames fill the queue before any pair is done with; from then on memory comes back.
+    EXPECT_GE(source.offered(), 20 - static_cast<int>(options.queueCapacity) - 3);
+    EXPECT_EQ(source.written(), source.offered());
 }
 
 TEST_F(FrameLoopTest, TheTapDeliversCopiesOfTheNextPairs) {
