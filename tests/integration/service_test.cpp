@@ -201,6 +201,19 @@ protected:
 
     bool waitForLog(const std::string& text) { return daemon_->waitForOutput(text, kStartTimeout); }
 
+    double frameRate() {
+        double perSecond = 0.0;
+        std::sscanf(get("FrameRate").c_str(), "d %lf", &perSecond);
+        return perSecond;
+    }
+
+    bool waitForFrameRate(double perSecond) {
+        const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+        while (std::chrono::steady_clock::now() < deadline && frameRate() < perSecond)
+            std::this_thread::sleep_for(100ms);
+        return frameRate() >= perSecond;
+    }
+
     std::string get(const std::string& name) {
         const test::ProcessResult result = test::runProcess(property("get-property", name));
         EXPECT_EQ(result.exitCode, 0) << result.err;
@@ -819,6 +832,16 @@ struct FloodReplies {
     int answered = 0, busy = 0, ioError = 0, succeeded = 0;
     std::string others;
 
+    // Processes `client`'s replies until `count` were answered or `within` passed.
+    void waitFor(sd_bus* client, int count, std::chrono::milliseconds within) {
+        const auto until = std::chrono::steady_clock::now() + within;
+        while (answered < count && std::chrono::steady_clock::now() < until) {
+            if (sd_bus_process(client, nullptr) > 0)
+                continue;
+            sd_bus_wait(client, 100'000);
+        }
+    }
+
     static int onReply(sd_bus_message* reply, void* userdata, sd_bus_error*) {
         auto* replies = static_cast<FloodReplies*>(userdata);
         ++replies->answered;
@@ -837,15 +860,7 @@ struct FloodReplies {
 
 TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
     startDaemon();
-    const auto frameRate = [this] {
-        double perSecond = 0.0;
-        std::sscanf(get("FrameRate").c_str(), "d %lf", &perSecond);
-        return perSecond;
-    };
-    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
-    while (std::chrono::steady_clock::now() < deadline && frameRate() < 8.0)
-        std::this_thread::sleep_for(100ms);
-    ASSERT_GT(frameRate(), 8.0);  // the recording runs at 10 frames/s
+    ASSERT_TRUE(waitForFrameRate(8.0));  // the recording runs at 10 frames/s
 
     // 40 calls at once, each with a pipe nobody reads, already full: the first eight are held until their
     // writes time out (3 s), the others are refused at once.
@@ -870,19 +885,11 @@ TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
                                      "Snapshot", FloodReplies::onReply, &replies, "sh", "overlay", ends[1]),
             0);
     }
-    const auto waitForReplies = [&](int count, std::chrono::milliseconds within) {
-        const auto until = std::chrono::steady_clock::now() + within;
-        while (replies.answered < count && std::chrono::steady_clock::now() < until) {
-            if (sd_bus_process(client.get(), nullptr) > 0)
-                continue;
-            sd_bus_wait(client.get(), 100'000);
-        }
-    };
-    waitForReplies(kCalls - static_cast<int>(service::SnapshotRequests::kMostPending), 2s);
+    replies.waitFor(client.get(), kCalls - static_cast<int>(service::SnapshotRequests::kMostPending), 2s);
     EXPECT_EQ(replies.busy, kCalls - static_cast<int>(service::SnapshotRequests::kMostPending));
     // Meanwhile the frames go on.
     EXPECT_GT(frameRate(), 8.0);
-    waitForReplies(kCalls, 10s);
+    replies.waitFor(client.get(), kCalls, 10s);
     EXPECT_EQ(replies.answered, kCalls);
     EXPECT_EQ(replies.ioError, static_cast<int>(service::SnapshotRequests::kMostPending));
     EXPECT_EQ(replies.others, "");
@@ -895,15 +902,7 @@ TEST_F(ServiceTest, AClientThatFloodsSnapshotsGetsBusyAndTheFramesGoOn) {
 
 TEST_F(ServiceTest, AClientThatFloodsCalibrateGetsBusyAndTheFramesGoOn) {
     startDaemon({}, {}, CalibrationSceneRecording::path());
-    const auto frameRate = [this] {
-        double perSecond = 0.0;
-        std::sscanf(get("FrameRate").c_str(), "d %lf", &perSecond);
-        return perSecond;
-    };
-    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
-    while (std::chrono::steady_clock::now() < deadline && frameRate() < 8.0)
-        std::this_thread::sleep_for(100ms);
-    ASSERT_GT(frameRate(), 8.0);  // the recording runs at 10 frames/s
+    ASSERT_TRUE(waitForFrameRate(8.0));  // the recording runs at 10 frames/s
 
     // 40 calls at once: the first starts a calibration (100 pairs, 10 s), every other is refused at once.
     sd_bus* raw = nullptr;
@@ -922,12 +921,7 @@ TEST_F(ServiceTest, AClientThatFloodsCalibrateGetsBusyAndTheFramesGoOn) {
         ASSERT_GE(sd_bus_call_async(client.get(), nullptr, call.get(), FloodReplies::onReply, &replies, 0),
                   0);
     }
-    const auto until = std::chrono::steady_clock::now() + 5s;
-    while (replies.answered < kCalls && std::chrono::steady_clock::now() < until) {
-        if (sd_bus_process(client.get(), nullptr) > 0)
-            continue;
-        sd_bus_wait(client.get(), 100'000);
-    }
+    replies.waitFor(client.get(), kCalls, 5s);
     EXPECT_EQ(replies.answered, kCalls);
     EXPECT_EQ(replies.succeeded, 1);
     EXPECT_EQ(replies.busy, kCalls - 1);

@@ -19,15 +19,29 @@ struct DragScore {
     int touchDowns = 0;      // contacts that went down while a finger lay on the table
 };
 
+// What the daemon gives the pipeline on the simulated rig.
+PipelineSettings rigSettings(const sim::Simulator& simulator) {
+    PipelineSettings settings;
+    settings.calibration = simulator.calibration();
+    settings.pattern = simulator.pattern();
+    settings.touchHeightMm = 3.0;
+    return settings;
+}
+
+// The pipeline on two consecutive frames, whichever of them shows O + P.
+const PipelineResult& processInOrder(TouchPipeline& pipeline, const Frame& older, const Frame& newer,
+                                     const PipelineSettings& settings) {
+    const bool olderPositive = older.polarity == Polarity::Positive;
+    return pipeline.process(FramePair{olderPositive ? older : newer, olderPositive ? newer : older},
+                            settings);
+}
+
 DragScore scoreDrags(const std::string& scenario) {
     sim::SimParameters parameters;
     parameters.scenario = scenario;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    PipelineSettings settings;
-    settings.calibration = simulator.calibration();
-    settings.pattern = simulator.pattern();
-    settings.touchHeightMm = 3.0;
+    const PipelineSettings settings = rigSettings(simulator);
 
     DragScore score;
     Frame older, newer;
@@ -39,9 +53,7 @@ DragScore scoreDrags(const std::string& scenario) {
     simulator.render(0, older, olderTruth);
     for (std::uint64_t index = 1; index < frames; ++index) {
         simulator.render(index, newer, truth);
-        const bool olderPositive = older.polarity == Polarity::Positive;
-        const PipelineResult& result = pipeline.process(
-            FramePair{olderPositive ? older : newer, olderPositive ? newer : older}, settings);
+        const PipelineResult& result = processInOrder(pipeline, older, newer, settings);
         std::swap(older, newer);
 
         bool onTable = false;
@@ -83,10 +95,7 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     parameters.scenario = "grid35";
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    PipelineSettings settings;
-    settings.calibration = simulator.calibration();
-    settings.pattern = simulator.pattern();
-    settings.touchHeightMm = 3.0;
+    const PipelineSettings settings = rigSettings(simulator);
     HandSegmenter segmenter(SegmentationOptions{});
     segmenter.setRig(*settings.calibration, settings.pattern);
 
@@ -97,9 +106,7 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     simulator.render(0, older, truth);
     for (std::uint64_t index = 1; index < 160; ++index) {
         simulator.render(index, newer, truth);
-        const bool olderPositive = older.polarity == Polarity::Positive;
-        const PipelineResult& result = pipeline.process(
-            FramePair{olderPositive ? older : newer, olderPositive ? newer : older}, settings);
+        const PipelineResult& result = processInOrder(pipeline, older, newer, settings);
         std::swap(older, newer);
         const int handPixels = cv::countNonZero(truth.handMask & segmenter.judgedRegion());
         if (handPixels == 0) {
@@ -131,10 +138,7 @@ TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
     parameters.startS = 1.4;  // the first tap touches from 1.7 s on
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    PipelineSettings settings;
-    settings.calibration = simulator.calibration();
-    settings.pattern = simulator.pattern();
-    settings.touchHeightMm = 3.0;
+    const PipelineSettings settings = rigSettings(simulator);
     const auto centreQuarter = [](const Frame& frame) {
         Frame cropped = frame;
         const cv::Size size = frame.image.size();
@@ -143,9 +147,7 @@ TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
         return cropped;
     };
     const auto process = [&](const Frame& older, const Frame& newer) -> const PipelineResult& {
-        const bool olderPositive = older.polarity == Polarity::Positive;
-        return pipeline.process(FramePair{olderPositive ? older : newer, olderPositive ? newer : older},
-                                settings);
+        return processInOrder(pipeline, older, newer, settings);
     };
     const auto touching = [](const PipelineResult& result) {
         return std::any_of(result.contacts.begin(), result.contacts.end(),

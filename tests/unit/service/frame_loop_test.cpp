@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -209,6 +210,18 @@ class FrameLoopTest : public ::testing::Test {
 protected:
     void SetUp() override { test::writeCodedRecording(dir_ / "recording", test::smallRig(), 20, 8333); }
 
+    // A loop on `source` run to the end of its stream, the camera waiting for the pipeline.
+    std::unique_ptr<FrameLoop> runToTheEnd(io::FrameSource& source, CollectingSink& sink) {
+        LoopOptions options;
+        options.overflow = FrameQueue::Overflow::Block;
+        auto loop =
+            std::make_unique<FrameLoop>(source, pipeline_, std::vector<io::TouchSink*>{&sink}, nullptr,
+                                        options, core::PipelineSettings{}, notifications_.callback());
+        loop->start();
+        EXPECT_TRUE(notifications_.waitUntil([&] { return loop->finished(); }, 30s));
+        return loop;
+    }
+
     test::TempDir dir_;
     Notifications notifications_;
     ScriptedPipeline pipeline_;
@@ -217,16 +230,12 @@ protected:
 TEST_F(FrameLoopTest, RunsToTheEndOfTheStreamAndReleasesTheContacts) {
     io::ReplaySource source(dir_ / "recording", false);
     CollectingSink sink;
-    LoopOptions options;
-    options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
-    loop.start();
-    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
-    const LoopStatistics statistics = loop.statistics();
+    const std::unique_ptr<FrameLoop> loop = runToTheEnd(source, sink);
+    const LoopStatistics statistics = loop->statistics();
     EXPECT_EQ(statistics.frames, 20u);
     EXPECT_EQ(statistics.pairs, 19u);
     EXPECT_EQ(statistics.dropped, 0u);
-    EXPECT_FALSE(loop.failure());
+    EXPECT_FALSE(loop->failure());
     const std::vector<std::uint64_t> indices = sink.indices();
     ASSERT_EQ(indices.size(), 20u);  // one per pair, then the release
     EXPECT_EQ(indices.back(), 19u);
@@ -263,12 +272,7 @@ TEST_F(FrameLoopTest, ASlowPipelineDropsTheOldestFramesAndCountsThem) {
 TEST_F(FrameLoopTest, FramesTheSourceLostCountAsDropped) {
     LossySource source(dir_ / "recording");
     CollectingSink sink;
-    LoopOptions options;
-    options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
-    loop.start();
-    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
-    const LoopStatistics statistics = loop.statistics();
+    const LoopStatistics statistics = runToTheEnd(source, sink)->statistics();
     EXPECT_EQ(statistics.frames, 14u);  // of 20
     EXPECT_EQ(statistics.dropped, 6u);
 }
@@ -334,14 +338,9 @@ TEST_F(FrameLoopTest, AStalledCameraReleasesEveryContactAndDetectionWaitsForItsF
 TEST_F(FrameLoopTest, TheCameraWritesFramesIntoTheMemoryOfFramesThePipelineIsDoneWith) {
     SpareWitnessSource source(dir_ / "recording");
     CollectingSink sink;
-    LoopOptions options;
-    options.overflow = FrameQueue::Overflow::Block;
-    FrameLoop loop(source, pipeline_, {&sink}, nullptr, options, {}, notifications_.callback());
-    loop.start();
-    ASSERT_TRUE(notifications_.waitUntil([&] { return loop.finished(); }, 30s));
-    EXPECT_EQ(loop.statistics().pairs, 19u);
+    EXPECT_EQ(runToTheEnd(source, sink)->statistics().pairs, 19u);
     // The first frames fill the queue before any pair is done with; from then on memory comes back.
-    EXPECT_GE(source.offered(), 20 - static_cast<int>(options.queueCapacity) - 3);
+    EXPECT_GE(source.offered(), 20 - static_cast<int>(LoopOptions{}.queueCapacity) - 3);
     EXPECT_EQ(source.written(), source.offered());
 }
 
