@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "core/camera_model.h"
 #include "core/code_image.h"
@@ -115,7 +117,7 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     result_.sceneStill = false;
     result_.timestampUs = pair.latest().timestampUs;
     result_.handMask.create(pair.positive.image.size(), CV_8UC1);
-    const auto idle = [&](const std::string& reason) -> const PipelineResult& {
+    const auto idle = [&](std::string_view reason) -> const PipelineResult& {
         // A pair of frames of two sizes (the camera's changed between them) shows nothing.
         if (pair.negative.image.size() == pair.positive.image.size()) {
             computeSubtractionAndTexture(pair, result_.subtraction, result_.texture);
