@@ -101,6 +101,26 @@ public:
         }
         return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
     }
+    // Whether a sample lies within `limit` (squared distance) of the feature: the search stops at the first.
+    bool anyWithin(const float* feature, float limit) const {
+        const Lanes a = {feature[0], feature[0], feature[0], feature[0]};
+        const Lanes b = {feature[1], feature[1], feature[1], feature[1]};
+        const Lanes c = {feature[2], feature[2], feature[2], feature[2]};
+        const Lanes bound = {limit, limit, limit, limit};
+        for (int k = 0; k < count_; k += kLanes) {
+            Lanes da, db, dc;
+            std::memcpy(&da, first_ + k, sizeof da);
+            std::memcpy(&db, second_ + k, sizeof db);
+            std::memcpy(&dc, third_ + k, sizeof dc);
+            da -= a;
+            db -= b;
+            dc -= c;
+            const auto within = da * da + db * db + dc * dc <= bound;
+            if (within[0] | within[1] | within[2] | within[3])
+                return true;
+        }
+        return false;
+    }
 
 private:
     static constexpr int kLanes = 4;
@@ -223,6 +243,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     queue_.resize(blockCount);
     component_.resize(blockCount);
     blocksToHand_.resize(blockCount);
+    tableDistance_.resize(blockCount);
     for (int by = reach; by < blocks.height - reach; ++by)
         for (int bx = reach; bx < blocks.width - reach; ++bx)
             displayBlocks_.at<uchar>(by, bx) =
@@ -485,6 +506,7 @@ void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
     // A hand over dark content or in another part's shadow shows no code: such blocks join the hand when
     // their colour is nearer the hand's next to them than the table's around them.
     constexpr int kTableReach = 3;
+    std::fill(tableDistance_.begin(), tableDistance_.end(), -1.0f);
     while (head < tail) {
         const int i = queue_[head++];
         const int y = i / cols, x = i % cols;
@@ -496,13 +518,18 @@ void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
                 const int j = ny * cols + nx;
                 const float* colour = blockFeature(texture, ny, nx);
                 const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
-                float tableDistance = std::numeric_limits<float>::max();
-                for (int ty = std::max(ny - kTableReach, 0); ty <= std::min(ny + kTableReach, rows - 1); ++ty)
-                    for (int tx = std::max(nx - kTableReach, 0); tx <= std::min(nx + kTableReach, cols - 1);
-                         ++tx)
-                        if (classes[ty * cols + tx] == Table)
-                            tableDistance = std::min(
-                                tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
+                float& tableDistance = tableDistance_[static_cast<std::size_t>(j)];
+                if (tableDistance < 0.0f) {
+                    tableDistance = std::numeric_limits<float>::max();
+                    for (int ty = std::max(ny - kTableReach, 0); ty <= std::min(ny + kTableReach, rows - 1);
+                         ++ty)
+                        for (int tx = std::max(nx - kTableReach, 0);
+                             tx <= std::min(nx + kTableReach, cols - 1); ++tx)
+                            if (classes[ty * cols + tx] == Table)
+                                tableDistance =
+                                    std::min(tableDistance,
+                                             featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
+                }
                 if (handDistance < tableDistance) {
                     classes[j] = Grown;
                     queue_[tail++] = j;
@@ -554,6 +581,7 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
             }
     }
 
+    std::fill(tableDistance_.begin(), tableDistance_.end(), -1.0f);
     head = 0;
     tail = handBlocks;  // the hand blocks are still at the queue's front
     while (head < tail) {
@@ -569,15 +597,20 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                     continue;
                 const float* colour = blockFeature(texture, ny, nx);
                 const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
-                float tableDistance = std::numeric_limits<float>::max();
-                for (int ty = std::max(ny - sampleReach, 0); ty <= std::min(ny + sampleReach, rows - 1); ++ty)
-                    for (int tx = std::max(nx - sampleReach, 0); tx <= std::min(nx + sampleReach, cols - 1);
-                         ++tx) {
-                        const int k = ty * cols + tx;
-                        if (classes[k] == Table && blocksToHand_[k] > reach)
-                            tableDistance = std::min(
-                                tableDistance, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
-                    }
+                float& tableDistance = tableDistance_[static_cast<std::size_t>(j)];
+                if (tableDistance < 0.0f) {
+                    tableDistance = std::numeric_limits<float>::max();
+                    for (int ty = std::max(ny - sampleReach, 0); ty <= std::min(ny + sampleReach, rows - 1);
+                         ++ty)
+                        for (int tx = std::max(nx - sampleReach, 0);
+                             tx <= std::min(nx + sampleReach, cols - 1); ++tx) {
+                            const int k = ty * cols + tx;
+                            if (classes[k] == Table && blocksToHand_[k] > reach)
+                                tableDistance =
+                                    std::min(tableDistance,
+                                             featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
+                        }
+                }
                 if (kTouchingColourRatio * handDistance < tableDistance &&
                     tableDistance < std::numeric_limits<float>::max()) {
                     classes[j] = Candidate;  // until the size of what grew is known
@@ -658,6 +691,7 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
     const int motionLevel = static_cast<int>(std::ceil(kMotionAmplitudes * tableAmplitude_));
     const int litSum = static_cast<int>(std::ceil((2 * kLitReach + 1) * (2 * kLitReach + 1) * litAmplitude_));
     litPatch_.resize(static_cast<std::size_t>((blockPx + 2 * kLitReach) * (blockPx + 2 * kLitReach)));
+    litColumns_.resize(static_cast<std::size_t>(blockPx + 2 * kLitReach));
     measureDepthInHand();
     const auto pure = [&](int y, int x) { return depthInHand_.at<uchar>(y, x) > depth; };
     // Only the blocks next to the hand's are looked at.
@@ -714,14 +748,18 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                 const int y = block.y + py;
                 const uchar* row = texture.ptr<uchar>(y);
                 uchar* out = mask.ptr<uchar>(y);
+                int* columnSums = litColumns_.data();
+                for (int px = 0; px < side; ++px) {
+                    const int* patch = litPatch_.data() + py * side + px;
+                    columnSums[px] = 0;
+                    for (int dy = 0; dy <= 2 * kLitReach; ++dy)
+                        columnSums[px] += patch[dy * side];
+                }
                 for (int px = 0; px < blockPx; ++px) {
                     const int x = block.x + px;
                     int localSum = 0;
-                    for (int dy = 0; dy <= 2 * kLitReach; ++dy) {
-                        const int* patch = litPatch_.data() + (py + dy) * side + px;
-                        for (int dx = 0; dx <= 2 * kLitReach; ++dx)
-                            localSum += patch[dx];
-                    }
+                    for (int dx = 0; dx <= 2 * kLitReach; ++dx)
+                        localSum += columnSums[px + dx];
                     if (c != Grown && localSum < litSum) {
                         out[x] = 0;
                         continue;
@@ -734,7 +772,12 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     for (int ch = 0; ch < channels; ++ch)
                         colour[ch] = row[x * channels + ch];
                     colourFeature(colour, channels, pixel);
-                    out[x] = handSide.nearestDistance(pixel) < other.nearestDistance(pixel) ? 255 : 0;
+                    // Hand when every sample of the other side lies farther than the nearest of the hand's.
+                    const float handDistance = handSide.nearestDistance(pixel);
+                    out[x] = handDistance < std::numeric_limits<float>::max() &&
+                                     !other.anyWithin(pixel, handDistance)
+                                 ? 255
+                                 : 0;
                 }
             }
         }
