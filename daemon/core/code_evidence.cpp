@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 namespace everytouch::core {
 
 namespace {
@@ -33,6 +35,29 @@ void sumCode(const cv::Mat& predicted, int blockPx, cv::Mat& codeSums) {
         }
 }
 
+// Adds one row of S, its squares and its products with the predicted code P to the columns' sums, a vector
+// of columns at a time: 20 us for a 648 x 488 frame where a block at a time took 220 (BM_CodeEvidence).
+void addRow(const short* s, const float* p, int width, int* sum, int* sumSquares, float* cross) {
+    int x = 0;
+#if CV_SIMD128
+    for (; x + 8 <= width; x += 8) {
+        cv::v_int32x4 low, high;
+        cv::v_expand(cv::v_load(s + x), low, high);
+        cv::v_store(sum + x, cv::v_load(sum + x) + low);
+        cv::v_store(sum + x + 4, cv::v_load(sum + x + 4) + high);
+        cv::v_store(sumSquares + x, cv::v_load(sumSquares + x) + low * low);
+        cv::v_store(sumSquares + x + 4, cv::v_load(sumSquares + x + 4) + high * high);
+        cv::v_store(cross + x, cv::v_load(cross + x) + cv::v_cvt_f32(low) * cv::v_load(p + x));
+        cv::v_store(cross + x + 4, cv::v_load(cross + x + 4) + cv::v_cvt_f32(high) * cv::v_load(p + x + 4));
+    }
+#endif
+    for (; x < width; ++x) {
+        sum[x] += s[x];
+        sumSquares[x] += s[x] * s[x];
+        cross[x] += static_cast<float>(s[x]) * p[x];
+    }
+}
+
 void windowStatistics(const cv::Mat& integral, int side, int blockPx, CodeEvidence::Window& window) {
     const int rows = integral.rows - 1, cols = integral.cols - 1, reach = side / 2;
     window.pixels = side * side * blockPx * blockPx;
@@ -41,25 +66,32 @@ void windowStatistics(const cv::Mat& integral, int side, int blockPx, CodeEviden
     window.varianceS.create(rows, cols, CV_32FC1);
     window.varianceCode.create(rows, cols, CV_32FC1);
     const double pixels = window.pixels;
+    const double perPixel = 1.0 / pixels;
     for (int by = 0; by < rows; ++by) {
         const int y0 = std::max(by - reach, 0), y1 = std::min(by + reach + 1, rows);
-        const BlockSums* top = integral.ptr<BlockSums>(y0);
-        const BlockSums* bottom = integral.ptr<BlockSums>(y1);
+        const double* top = integral.ptr<double>(y0);
+        const double* bottom = integral.ptr<double>(y1);
+        float* meanSRow = window.meanS.ptr<float>(by);
+        float* varianceSRow = window.varianceS.ptr<float>(by);
+        float* varianceCodeRow = window.varianceCode.ptr<float>(by);
+        float* correlationRow = window.correlation.ptr<float>(by);
         for (int bx = 0; bx < cols; ++bx) {
-            const int x0 = std::max(bx - reach, 0), x1 = std::min(bx + reach + 1, cols);
-            const BlockSums w = bottom[x1] - bottom[x0] - top[x1] + top[x0];
-            const double meanS = w[0] / pixels;
-            window.meanS.at<float>(by, bx) = static_cast<float>(meanS);
-            window.varianceS.at<float>(by, bx) =
-                static_cast<float>(std::max(0.0, w[1] / pixels - meanS * meanS));
-            window.varianceCode.at<float>(by, bx) = static_cast<float>(std::max(0.0, w[4]) / pixels);
-            const double denominator = std::sqrt(std::max(0.0, w[3]) * std::max(0.0, w[4]));
-            float& correlation = window.correlation.at<float>(by, bx);
+            const int x0 = std::max(bx - reach, 0) * kSums, x1 = std::min(bx + reach + 1, cols) * kSums;
+            double w[kSums];
+            for (int k = 0; k < kSums; ++k)
+                w[k] = bottom[x1 + k] - bottom[x0 + k] - top[x1 + k] + top[x0 + k];
+            const double meanS = w[0] * perPixel;
+            meanSRow[bx] = static_cast<float>(meanS);
+            varianceSRow[bx] = static_cast<float>(std::max(0.0, w[1] * perPixel - meanS * meanS));
+            varianceCodeRow[bx] = static_cast<float>(std::max(0.0, w[4]) * perPixel);
+            // In single precision: the correlation is kept as a float, and a double's square root and
+            // division cost several times a float's.
+            const float denominator =
+                std::sqrt(static_cast<float>(std::max(0.0, w[3])) * static_cast<float>(std::max(0.0, w[4])));
             if (w[5] < pixels - 0.5)
-                correlation =
-                    std::numeric_limits<float>::quiet_NaN();  // off the code, or at the image's edge
+                correlationRow[bx] = std::numeric_limits<float>::quiet_NaN();  // off the code, or at the edge
             else
-                correlation = denominator > 0 ? static_cast<float>(w[2] / denominator) : 0.0f;
+                correlationRow[bx] = denominator > 0 ? static_cast<float>(w[2]) / denominator : 0.0f;
         }
     }
 }
@@ -79,20 +111,31 @@ void measureCodeEvidence(const cv::Mat& subtraction, const TableCode& tableCode,
     // albedo and the content's brightness, which change across a window (a printed line, a stain); within a
     // small block it is nearly constant, so the correlation measures the code's pattern, not them.
     evidence.blockSums.create(rows, cols, CV_64FC(kSums));
+    // A row of blocks at a time: each pixel column's sums over the block's rows, then each block's over its
+    // columns.
+    const int width = cols * blockPx;
+    evidence.columnSum.resize(static_cast<std::size_t>(width));
+    evidence.columnSumSquares.resize(static_cast<std::size_t>(width));
+    evidence.columnCross.resize(static_cast<std::size_t>(width));
+    int* columnSum = evidence.columnSum.data();
+    int* columnSumSquares = evidence.columnSumSquares.data();
+    float* columnCross = evidence.columnCross.data();
     for (int by = 0; by < rows; ++by) {
+        std::fill_n(columnSum, width, 0);
+        std::fill_n(columnSumSquares, width, 0);
+        std::fill_n(columnCross, width, 0.0f);
+        for (int y = by * blockPx; y < (by + 1) * blockPx; ++y)
+            addRow(subtraction.ptr<short>(y), tableCode.predicted.ptr<float>(y), width, columnSum,
+                   columnSumSquares, columnCross);
         BlockSums* sums = evidence.blockSums.ptr<BlockSums>(by);
         const cv::Vec3d* code = evidence.codeSums.ptr<cv::Vec3d>(by);
         for (int bx = 0; bx < cols; ++bx) {
             int sum = 0, sumSquares = 0;
             float cross = 0.0f;
-            for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
-                const short* s = subtraction.ptr<short>(y) + bx * blockPx;
-                const float* p = tableCode.predicted.ptr<float>(y) + bx * blockPx;
-                for (int x = 0; x < blockPx; ++x) {
-                    sum += s[x];
-                    sumSquares += s[x] * s[x];
-                    cross += s[x] * p[x];
-                }
+            for (int x = bx * blockPx; x < (bx + 1) * blockPx; ++x) {
+                sum += columnSum[x];
+                sumSquares += columnSumSquares[x];
+                cross += columnCross[x];
             }
             const cv::Vec3d& c = code[bx];
             BlockSums& b = sums[bx];
@@ -109,19 +152,18 @@ void measureCodeEvidence(const cv::Mat& subtraction, const TableCode& tableCode,
         }
     }
     evidence.integral.create(rows + 1, cols + 1, CV_64FC(kSums));
-    BlockSums* firstRow = evidence.integral.ptr<BlockSums>(0);
-    for (int bx = 0; bx <= cols; ++bx)
-        firstRow[bx] = BlockSums::all(0);
+    std::fill_n(evidence.integral.ptr<double>(0), (cols + 1) * kSums, 0.0);
     for (int by = 0; by < rows; ++by) {
-        const BlockSums* sums = evidence.blockSums.ptr<BlockSums>(by);
-        const BlockSums* above = evidence.integral.ptr<BlockSums>(by);
-        BlockSums* out = evidence.integral.ptr<BlockSums>(by + 1);
-        BlockSums rowSum = BlockSums::all(0);
-        out[0] = BlockSums::all(0);
-        for (int bx = 0; bx < cols; ++bx) {
-            rowSum += sums[bx];
-            out[bx + 1] = above[bx + 1] + rowSum;
-        }
+        const double* sums = evidence.blockSums.ptr<double>(by);
+        const double* above = evidence.integral.ptr<double>(by);
+        double* out = evidence.integral.ptr<double>(by + 1);
+        double rowSum[kSums] = {};
+        std::fill_n(out, kSums, 0.0);
+        for (int i = 0; i < cols * kSums; i += kSums)
+            for (int k = 0; k < kSums; ++k) {
+                rowSum[k] += sums[i + k];
+                out[i + kSums + k] = above[i + kSums + k] + rowSum[k];
+            }
     }
     windowStatistics(evidence.integral, evidence.windowBlocks, blockPx, evidence.narrow);
     windowStatistics(evidence.integral, evidence.wideWindowBlocks, blockPx, evidence.wide);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <opencv2/core/mat.hpp>
 
 #include "core/table_code.h"
@@ -31,6 +33,10 @@ struct CodeEvidence {
     cv::Mat integral;   // CV_64FC(6), one row and column more
     cv::Mat codeSums;   // CV_64FC3: count, sum P, sum P^2 (from the table code, recomputed when it changes)
     const cv::Mat* codeOf = nullptr;  // the predicted code the code sums were taken from
+    // Each pixel column's sums of S, S^2 and S P over one row of blocks while they are added up.
+    std::vector<int> columnSum;
+    std::vector<int> columnSumSquares;
+    std::vector<float> columnCross;
 };
 
 // subtraction: CV_16SC1 (core/code_image.h), camera size (the last partial blocks are left out).

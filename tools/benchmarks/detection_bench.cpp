@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/code_blur.h"
+#include "core/code_evidence.h"
 #include "core/code_image.h"
 #include "core/fingertips.h"
 #include "core/hand_segmentation.h"
@@ -188,6 +189,21 @@ void BM_PolarityCheck(benchmark::State& state) {
     state.counters["correlation"] = lock.correlation();
 }
 BENCHMARK(BM_PolarityCheck)->Unit(benchmark::kMicrosecond);
+
+// The code's evidence over every block of the frame: the first step of the segmentation, whatever is in view.
+void BM_CodeEvidence(benchmark::State& state) {
+    const Scene& scene = oneHand();
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::CodeEvidence evidence;
+    cv::Mat subtraction, texture;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    for (auto _ : state) {
+        core::measureCodeEvidence(subtraction, segmenter.tableCode(), evidence);
+        benchmark::DoNotOptimize(evidence.narrow.correlation.data);
+    }
+}
+BENCHMARK(BM_CodeEvidence)->Unit(benchmark::kMicrosecond);
 
 // The code's blur, read once per rig from the first pair that shows the code.
 void BM_CodeBlur(benchmark::State& state) {
