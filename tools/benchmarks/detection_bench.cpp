@@ -99,17 +99,19 @@ void segmentAndFindFingertips(benchmark::State& state, const Scene& scene, core:
         core::findFingertips(mask, fingertipOptions, scratch, fingertips);
     }
     Timings timings;
-    std::size_t i = 0, found = 0;
+    std::size_t i = 0, found = 0, handPixels = 0;
     for (auto _ : state) {
         const auto start = Clock::now();
         segmenter.segment(textures[i], subtractions[i], mask);
         core::findFingertips(mask, fingertipOptions, scratch, fingertips);
         timings.add(Clock::now() - start);
         found += fingertips.size();
+        handPixels += static_cast<std::size_t>(cv::countNonZero(mask));
         i = (i + 1) % scene.pairs.size();
     }
     timings.report(state);
     state.counters["fingertips"] = static_cast<double>(found) / static_cast<double>(state.iterations());
+    state.counters["hand_px"] = static_cast<double>(handPixels) / static_cast<double>(state.iterations());
 }
 
 void BM_SegmentationAndFingertipsOneHand(benchmark::State& state) {
