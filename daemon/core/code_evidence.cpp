@@ -142,9 +142,11 @@ void measureCodeEvidence(const cv::Mat& subtraction, const TableCode& tableCode,
             b[0] = sum;
             b[1] = sumSquares;
             if (c[0] > 0) {
-                b[2] = cross - sum * c[1] / c[0];
-                b[3] = sumSquares - double(sum) * sum / c[0];
-                b[4] = c[2] - c[1] * c[1] / c[0];
+                // A block's pixel count, a power of two at the default block size: its reciprocal is exact.
+                const double perPixel = 1.0 / c[0];
+                b[2] = cross - sum * c[1] * perPixel;
+                b[3] = sumSquares - double(sum) * sum * perPixel;
+                b[4] = c[2] - c[1] * c[1] * perPixel;
             } else {
                 b[2] = b[3] = b[4] = 0.0;
             }

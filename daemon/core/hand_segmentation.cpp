@@ -1,6 +1,7 @@
 #include "core/hand_segmentation.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -66,6 +67,22 @@ float featureDistanceSquared(const float* a, const float* b) {
 constexpr int kColourReach = 3;
 constexpr int kColourSamples = (2 * kColourReach + 1) * (2 * kColourReach + 1);
 
+// The blocks around an outline block, nearest first: a pixel's colour most often resembles the blocks next to
+// it, so a search in this order finds a sample that settles its side sooner.
+const std::array<cv::Point, kColourSamples>& colourSampleOffsets() {
+    static const std::array<cv::Point, kColourSamples> offsets = [] {
+        std::array<cv::Point, kColourSamples> sorted;
+        int i = 0;
+        for (int dy = -kColourReach; dy <= kColourReach; ++dy)
+            for (int dx = -kColourReach; dx <= kColourReach; ++dx)
+                sorted[i++] = cv::Point(dx, dy);
+        std::stable_sort(sorted.begin(), sorted.end(),
+                         [](cv::Point a, cv::Point b) { return a.dot(a) < b.dot(b); });
+        return sorted;
+    }();
+    return offsets;
+}
+
 // Colour features of one side of the outline, and the squared distance from a pixel's feature to the nearest
 // of them. Each component is kept in its own array so that four samples are compared at once; the array's
 // tail repeats the last sample up to a multiple of four, which changes no minimum.
@@ -101,8 +118,9 @@ public:
         }
         return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
     }
-    // Whether a sample lies within `limit` (squared distance) of the feature: the search stops at the first.
-    bool anyWithin(const float* feature, float limit) const {
+    // Whether a sample lies within `limit` (squared distance) of the feature; with `strictly`, nearer than
+    // it. The search stops at the first.
+    bool anyWithin(const float* feature, float limit, bool strictly = false) const {
         const Lanes a = {feature[0], feature[0], feature[0], feature[0]};
         const Lanes b = {feature[1], feature[1], feature[1], feature[1]};
         const Lanes c = {feature[2], feature[2], feature[2], feature[2]};
@@ -115,7 +133,8 @@ public:
             da -= a;
             db -= b;
             dc -= c;
-            const auto within = da * da + db * db + dc * dc <= bound;
+            const Lanes distance = da * da + db * db + dc * dc;
+            const auto within = strictly ? distance < bound : distance <= bound;
             if (within[0] | within[1] | within[2] | within[3])
                 return true;
         }
@@ -714,21 +733,20 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             const bool inside = pure(by, bx);
             // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
             NearestColour hand, other, looseHand;
-            for (int dy = -kColourReach; dy <= kColourReach && !inside; ++dy)
-                for (int dx = -kColourReach; dx <= kColourReach; ++dx) {
-                    const int y = by + dy, x = bx + dx;
-                    const uchar n = classAt(y, x);
-                    if (n == Outside)
-                        continue;
-                    const float* colour = blockFeature(texture, y, x);
-                    if (isHand(n)) {
-                        looseHand.add(colour);
-                        if (pure(y, x))
-                            hand.add(colour);
-                    } else {
-                        other.add(colour);
-                    }
+            for (int k = 0; k < kColourSamples && !inside; ++k) {
+                const int y = by + colourSampleOffsets()[k].y, x = bx + colourSampleOffsets()[k].x;
+                const uchar n = classAt(y, x);
+                if (n == Outside)
+                    continue;
+                const float* colour = blockFeature(texture, y, x);
+                if (isHand(n)) {
+                    looseHand.add(colour);
+                    if (pure(y, x))
+                        hand.add(colour);
+                } else {
+                    other.add(colour);
                 }
+            }
             const NearestColour& handSide = hand.empty() ? looseHand : hand;
             // A pixel in the hand's own shadow gets no light from the projector, and no code: whatever its
             // colour, it is not the hand (a hand over black content loses its outline pixels here too).
@@ -744,6 +762,10 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     patch[px] = value <= motionLevel ? value : 0;
                 }
             }
+            // The side of the last pixel looked at: a pixel is searched for the nearest sample of the other
+            // side first, then for any nearer one of its guessed side, which is found soon when the guess
+            // holds. Either way the answer is the same: hand when its nearest sample is the hand's.
+            bool lastWasHand = isHand(c);
             for (int py = 0; py < blockPx; ++py) {
                 const int y = block.y + py;
                 const uchar* row = texture.ptr<uchar>(y);
@@ -772,12 +794,16 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     for (int ch = 0; ch < channels; ++ch)
                         colour[ch] = row[x * channels + ch];
                     colourFeature(colour, channels, pixel);
-                    // Hand when every sample of the other side lies farther than the nearest of the hand's.
-                    const float handDistance = handSide.nearestDistance(pixel);
-                    out[x] = handDistance < std::numeric_limits<float>::max() &&
-                                     !other.anyWithin(pixel, handDistance)
-                                 ? 255
-                                 : 0;
+                    bool isHandPixel;
+                    if (lastWasHand) {
+                        isHandPixel = handSide.anyWithin(pixel, other.nearestDistance(pixel), true);
+                    } else {
+                        const float handDistance = handSide.nearestDistance(pixel);
+                        isHandPixel = handDistance < std::numeric_limits<float>::max() &&
+                                      !other.anyWithin(pixel, handDistance);
+                    }
+                    out[x] = isHandPixel ? 255 : 0;
+                    lastWasHand = isHandPixel;
                 }
             }
         }
