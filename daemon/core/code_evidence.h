@@ -8,10 +8,19 @@
 
 namespace everytouch::core {
 
+// S and the table's code over a window of blocks.
+struct WindowStatistics {
+    float correlation = 0.0f;   // of S with the table's code; NaN off the code
+    float meanS = 0.0f;         // DN
+    float varianceS = 0.0f;     // about its mean, DN^2
+    float varianceCode = 0.0f;  // of the predicted code about each block's mean
+};
+
 // What the code says about each small block of the camera image, from one subtraction image S: how much
 // projector light reaches it and how well S there follows the table's predicted code. Blocks are blockPx
 // square; a block's statistics are taken over a window of blocks centred on it, at two sizes: a narrow one
-// that follows outlines closely and a wide one that still sees a faint code.
+// that follows outlines closely, kept for every block, and a wide one that still sees a faint code, taken
+// where it is asked for (the few blocks where the code is faint).
 struct CodeEvidence {
     int blockPx = 4;
     int windowBlocks = 3;      // the narrow window's side, blocks (odd)
@@ -26,7 +35,9 @@ struct CodeEvidence {
         int pixels = 0;        // pixels in a whole window
     };
     Window narrow;
-    Window wide;
+    // The wide window centred on one block, and the pixels it holds.
+    WindowStatistics wideAt(int by, int bx) const;
+    int widePixels() const;
 
     // Per-block sums, and their integral images, reused from frame to frame.
     cv::Mat blockSums;  // CV_64FC(6): sum S, sum S^2, covariance, variance of S, variance of P, code pixels

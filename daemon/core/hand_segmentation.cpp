@@ -329,7 +329,6 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
 
 void HandSegmenter::classifyBlocks() {
     const CodeEvidence::Window& narrow = evidence_.narrow;
-    const CodeEvidence::Window& wide = evidence_.wide;
     const int rows = narrow.correlation.rows, cols = narrow.correlation.cols;
     // Where the camera sees beyond the projection S holds nothing but noise: its level (which the largest
     // of three channels' differences lifts above zero) and its variance.
@@ -349,52 +348,62 @@ void HandSegmenter::classifyBlocks() {
     // What the table's code would correlate with where the code's amplitude is g: S = g P + noise gives
     // r = g sd(P) / sqrt(g^2 var(P) + noise). The camera's blur is predicted only approximately, so the
     // table reaches a fraction of that, measured in this frame among the blocks that are clearly lit.
-    const auto ideal = [&](const CodeEvidence::Window& window, int by, int bx) {
-        const float gain = 2.0f * std::max(0.0f, window.meanS.at<float>(by, bx) - zeroLevel);
-        const float codeVariance = window.varianceCode.at<float>(by, bx);
+    const auto ideal = [&](float meanS, float codeVariance) {
+        const float gain = 2.0f * std::max(0.0f, meanS - zeroLevel);
         return gain * std::sqrt(codeVariance) / std::sqrt(gain * gain * codeVariance + noiseVariance_);
     };
+    // The narrow window's ideal correlation on the display's blocks that show the code (NaN elsewhere).
+    narrowIdeal_.create(narrow.correlation.size(), CV_32FC1);
     values_.clear();
-    for (int by = 0; by < rows; ++by)
+    for (int by = 0; by < rows; ++by) {
+        const float* correlation = narrow.correlation.ptr<float>(by);
+        const float* meanS = narrow.meanS.ptr<float>(by);
+        const float* codeVariance = narrow.varianceCode.ptr<float>(by);
+        const uchar* onDisplay = displayBlocks_.ptr<uchar>(by);
+        float* idealRow = narrowIdeal_.ptr<float>(by);
         for (int bx = 0; bx < cols; ++bx) {
-            const float r = narrow.correlation.at<float>(by, bx);
-            const float expected = ideal(narrow, by, bx);
-            if (displayBlocks_.at<uchar>(by, bx) && !std::isnan(r) && expected > 0.5f)
-                values_.push_back(r / expected);
+            idealRow[bx] = std::numeric_limits<float>::quiet_NaN();
+            if (!onDisplay[bx] || std::isnan(correlation[bx]))
+                continue;
+            idealRow[bx] = ideal(meanS[bx], codeVariance[bx]);
+            if (idealRow[bx] > 0.5f)
+                values_.push_back(correlation[bx] / idealRow[bx]);
         }
+    }
     const float fidelity = std::clamp(quantile(values_, 0.9), 0.0f, 1.0f);
 
     // One standard deviation of a correlation over a window when nothing correlates: neighbouring pixels
     // share light through the blur, about two pixels per independent sample.
-    const auto chance = [](const CodeEvidence::Window& window) {
-        return std::sqrt(2.0f / static_cast<float>(window.pixels));
-    };
-    const float narrowChance = chance(narrow), wideChance = chance(wide);
+    const auto chance = [](int pixels) { return std::sqrt(2.0f / static_cast<float>(pixels)); };
+    const float narrowChance = chance(narrow.pixels), wideChance = chance(evidence_.widePixels());
 
     blockClass_.create(narrow.correlation.size(), CV_8UC1);
     values_.clear();
     for (int by = 0; by < rows; ++by)
         for (int bx = 0; bx < cols; ++bx) {
             uchar& c = blockClass_.at<uchar>(by, bx);
-            if (!displayBlocks_.at<uchar>(by, bx) || std::isnan(narrow.correlation.at<float>(by, bx))) {
+            const float narrowIdeal = narrowIdeal_.at<float>(by, bx);
+            if (std::isnan(narrowIdeal)) {
                 c = Outside;
                 continue;
             }
             // The narrow window where the code is strong enough there; the wide one where it is faint.
-            const CodeEvidence::Window* window = &narrow;
-            float expected = fidelity * ideal(narrow, by, bx);
-            if (expected < kSignificance * narrowChance && !std::isnan(wide.correlation.at<float>(by, bx))) {
-                window = &wide;
-                expected = fidelity * ideal(wide, by, bx);
+            float correlation = narrow.correlation.at<float>(by, bx);
+            float expected = fidelity * narrowIdeal;
+            if (expected < kSignificance * narrowChance) {
+                const WindowStatistics wide = evidence_.wideAt(by, bx);
+                if (std::isnan(wide.correlation)) {
+                    c = Unlit;
+                    continue;
+                }
+                correlation = wide.correlation;
+                expected = fidelity * ideal(wide.meanS, wide.varianceCode);
                 if (expected < kSignificance * wideChance) {
                     c = Unlit;  // the table's code would not stand out of the noise here either
                     continue;
                 }
-            } else if (expected < kSignificance * narrowChance) {
-                c = Unlit;
-                continue;
             }
-            if (window->correlation.at<float>(by, bx) >= 0.5f * expected) {
+            if (correlation >= 0.5f * expected) {
                 c = Table;
                 values_.push_back(narrow.meanS.at<float>(by, bx));
             } else {
@@ -502,14 +511,17 @@ const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx)
     if (known)
         return feature.val;
     const int blockPx = options_.blockPx, channels = texture.channels();
-    const float scale = 1.0f / static_cast<float>(blockPx * blockPx);
-    float colour[3] = {0.0f, 0.0f, 0.0f};
+    int sums[3] = {0, 0, 0};
     for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
         const uchar* row = texture.ptr<uchar>(y) + bx * blockPx * channels;
-        for (int x = 0; x < blockPx; ++x)
+        for (int x = 0; x < blockPx * channels; x += channels)
             for (int c = 0; c < channels; ++c)
-                colour[c] += row[x * channels + c] * scale;
+                sums[c] += row[x + c];
     }
+    const float scale = 1.0f / static_cast<float>(blockPx * blockPx);
+    float colour[3] = {0.0f, 0.0f, 0.0f};
+    for (int c = 0; c < channels; ++c)
+        colour[c] = static_cast<float>(sums[c]) * scale;
     colourFeature(colour, channels, feature.val);
     known = 1;
     return feature.val;

@@ -127,11 +127,12 @@ private:
     float noiseVariance_ = 0.0f;   // of S where only noise is seen (DN^2)
 
     CodeEvidence evidence_;
-    cv::Mat blockClass_;           // CV_8UC1, block grid
-    cv::Mat blockColour_;          // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
-    cv::Mat colourKnown_;          // CV_8UC1, block grid: 1 where the colour has been measured this frame
-    cv::Rect handBox_;             // block grid: the box of the hand's blocks (findHandBox)
-    cv::Mat depthInHand_;          // CV_8UC1, block grid (measureDepthInHand)
+    cv::Mat narrowIdeal_;  // CV_32FC1, block grid: the narrow window's ideal correlation (classifyBlocks)
+    cv::Mat blockClass_;   // CV_8UC1, block grid
+    cv::Mat blockColour_;  // CV_32FC3, block grid: mean texture colour as chromaticity and brightness
+    cv::Mat colourKnown_;  // CV_8UC1, block grid: 1 where the colour has been measured this frame
+    cv::Rect handBox_;     // block grid: the box of the hand's blocks (findHandBox)
+    cv::Mat depthInHand_;  // CV_8UC1, block grid (measureDepthInHand)
     std::vector<int> litPatch_;    // S around one block, as labelPixels' lit test counts it
     std::vector<int> litColumns_;  // one row of litPatch_'s sums over the lit test's height
     std::vector<float> values_;
