@@ -100,20 +100,11 @@ public:
         ++count_;
     }
     float nearestDistance(const float* feature) const {
-        const Lanes a = {feature[0], feature[0], feature[0], feature[0]};
-        const Lanes b = {feature[1], feature[1], feature[1], feature[1]};
-        const Lanes c = {feature[2], feature[2], feature[2], feature[2]};
+        const Query query(feature);
         constexpr float kFar = std::numeric_limits<float>::max();
         Lanes nearest = {kFar, kFar, kFar, kFar};
         for (int k = 0; k < count_; k += kLanes) {
-            Lanes da, db, dc;
-            std::memcpy(&da, first_ + k, sizeof da);
-            std::memcpy(&db, second_ + k, sizeof db);
-            std::memcpy(&dc, third_ + k, sizeof dc);
-            da -= a;
-            db -= b;
-            dc -= c;
-            const Lanes distance = da * da + db * db + dc * dc;
+            const Lanes distance = distancesAt(query, k);
             nearest = distance < nearest ? distance : nearest;
         }
         return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
@@ -121,19 +112,10 @@ public:
     // Whether a sample lies within `limit` (squared distance) of the feature; with `strictly`, nearer than
     // it. The search stops at the first.
     bool anyWithin(const float* feature, float limit, bool strictly = false) const {
-        const Lanes a = {feature[0], feature[0], feature[0], feature[0]};
-        const Lanes b = {feature[1], feature[1], feature[1], feature[1]};
-        const Lanes c = {feature[2], feature[2], feature[2], feature[2]};
+        const Query query(feature);
         const Lanes bound = {limit, limit, limit, limit};
         for (int k = 0; k < count_; k += kLanes) {
-            Lanes da, db, dc;
-            std::memcpy(&da, first_ + k, sizeof da);
-            std::memcpy(&db, second_ + k, sizeof db);
-            std::memcpy(&dc, third_ + k, sizeof dc);
-            da -= a;
-            db -= b;
-            dc -= c;
-            const Lanes distance = da * da + db * db + dc * dc;
+            const Lanes distance = distancesAt(query, k);
             const auto within = strictly ? distance < bound : distance <= bound;
             if (within[0] | within[1] | within[2] | within[3])
                 return true;
@@ -144,6 +126,25 @@ public:
 private:
     static constexpr int kLanes = 4;
     typedef float Lanes __attribute__((vector_size(kLanes * sizeof(float))));
+    // A feature's components, each in every lane.
+    struct Query {
+        explicit Query(const float* feature)
+            : first{feature[0], feature[0], feature[0], feature[0]},
+              second{feature[1], feature[1], feature[1], feature[1]},
+              third{feature[2], feature[2], feature[2], feature[2]} {}
+        Lanes first, second, third;
+    };
+    // The squared distances from the query to samples k .. k + kLanes - 1.
+    Lanes distancesAt(const Query& query, int k) const {
+        Lanes da, db, dc;
+        std::memcpy(&da, first_ + k, sizeof da);
+        std::memcpy(&db, second_ + k, sizeof db);
+        std::memcpy(&dc, third_ + k, sizeof dc);
+        da -= query.first;
+        db -= query.second;
+        dc -= query.third;
+        return da * da + db * db + dc * dc;
+    }
     static constexpr int kCapacity = (kColourSamples + kLanes - 1) / kLanes * kLanes;
     float first_[kCapacity], second_[kCapacity], third_[kCapacity];
     int count_ = 0;
