@@ -159,6 +159,31 @@ const std::vector<KeySpec>& keySpecs() {
                  throw BadValue{"expected an absolute path, found \"" + value + "\""};
              config.calibrationPath = value;
          }},
+        {"Projector", "Output",
+         [](DaemonConfig& config, const std::string& value) {
+             if (value.empty() || value == "none")
+                 config.projector.output = ProjectorOutput::None;
+             else if (value == "external")
+                 config.projector.output = ProjectorOutput::External;
+             else if (value == "overlay" || value == "window")
+                 throw BadValue{value + " is not part of this build yet; it knows none and external"};
+             else
+                 throw BadValue{"expected none or external, found \"" + value + "\""};
+         }},
+        {"Projector", "Seed",
+         [](DaemonConfig& config, const std::string& value) {
+             if (value.empty()) {
+                 config.projector.seed = ProjectorConfig().seed;
+                 return;
+             }
+             std::uint64_t seed = 0;
+             const char* end = value.data() + value.size();
+             const auto [stop, error] = std::from_chars(value.data(), end, seed);
+             if (error != std::errc() || stop != end)
+                 throw BadValue{"expected a whole number from 0 to 18446744073709551615, found \"" + value +
+                                "\""};
+             config.projector.seed = seed;
+         }},
     };
     return specs;
 }
@@ -216,12 +241,14 @@ int onEntry(void* user, const char* sectionText, const char* keyText, const char
     const std::string section = sectionText, key = keyText, value = valueText;
     const std::string field = section.empty() ? key : "[" + section + "] " + key;
     if (section.empty()) {
-        state->fail(field, "not inside a [Section]; sections are [Camera], [Touch], [Output], [Calibration]");
+        state->fail(
+            field,
+            "not inside a [Section]; sections are [Camera], [Touch], [Output], [Calibration], [Projector]");
         return 0;
     }
     if (!isKnownSection(section)) {
-        state->fail(field,
-                    "unknown section [" + section + "]; known: [Camera], [Touch], [Output], [Calibration]");
+        state->fail(field, "unknown section [" + section +
+                               "]; known: [Camera], [Touch], [Output], [Calibration], [Projector]");
         return 0;
     }
     for (const KeySpec& spec : keySpecs()) {

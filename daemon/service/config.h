@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -26,6 +27,18 @@ inline constexpr double kMaxGainDb = 60.0;
 // A camera region smaller than this cannot hold a display's worth of code.
 inline constexpr int kMinRegionSide = 64;
 
+// Where the code comes from on a camera rig ([Projector] Output=): nowhere the daemon knows of, or a
+// projector that embeds it itself (a DLP development kit's pattern sequence, a media server) from the pattern
+// of a seed.
+enum class ProjectorOutput { None, External };
+
+struct ProjectorConfig {
+    ProjectorOutput output = ProjectorOutput::None;  // [Projector] Output=
+    std::uint64_t seed = 1;                          // [Projector] Seed=: the pattern's seed
+
+    bool operator==(const ProjectorConfig&) const = default;
+};
+
 // The daemon's configuration file, everytouchd.conf (documented key by key in everytouchd(8) and in the
 // shipped example). Command-line options override it.
 struct DaemonConfig {
@@ -34,6 +47,7 @@ struct DaemonConfig {
     double touchHeightMm = 3.0;  // [Touch] HeightMm=: touching at or below this height, mm
     std::optional<bool> uinput;  // [Output] Uinput=: virtual touchscreen; unset: only for cameras
     std::filesystem::path calibrationPath;  // [Calibration] Path=: calibration store; empty: not configured
+    ProjectorConfig projector;              // [Projector]
 
     bool operator==(const DaemonConfig&) const = default;
 };

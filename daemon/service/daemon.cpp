@@ -11,6 +11,10 @@
 #include <cstring>
 #include <system_error>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/pattern.h"
+#include "io/atomic_file.h"
 #include "io/input_error.h"
 #include "io/log.h"
 #include "service/bus_names.h"
@@ -153,8 +157,37 @@ void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
     else
         ET_LOG(Info) << "calibration from "
                      << (store_->keepsFile() ? store_->path().string() : std::string("the rig itself"));
-    if (store_->active())
+    if (store_->active()) {
         drawDisplayThrough(*store_->active());
+        adoptExternalCode(*store_->active());
+    }
+}
+
+void Daemon::adoptExternalCode(const core::Calibration& calibration) {
+    if (!cameraRig_ || config_.projector.output != ProjectorOutput::External ||
+        (!pattern_.empty() && pattern_.size() == calibration.projectorSize))
+        return;
+    core::PatternOptions options;
+    options.size = calibration.projectorSize;
+    options.seed = config_.projector.seed;
+    pattern_ = core::generatePattern(options);
+    ET_LOG(Info) << "code: the pattern of seed " << options.seed << " on the projector's "
+                 << options.size.width << "x" << options.size.height
+                 << " pixels, embedded by the projector itself";
+    if (!store_->keepsFile())
+        return;
+    // Beside the calibration, for the projector's side to show (255 on 1-bits, as a recording's pattern.png).
+    const std::filesystem::path file = store_->path().parent_path() / "pattern.png";
+    try {
+        std::vector<uchar> png;
+        cv::imencode(".png", pattern_ * 255, png);
+        io::writeFileAtomically(file,
+                                std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+        ET_LOG(Info) << "code: the pattern written to " << file.string();
+    } catch (const std::exception& error) {
+        ET_LOG(Warning) << "code: the pattern could not be written to " << file.string() << ": "
+                        << error.what();
+    }
 }
 
 void Daemon::drawDisplayThrough(const core::Calibration& calibration) {
@@ -305,6 +338,9 @@ std::string Daemon::stateReason() const {
                 return "camera lost, asking it again: " + *lost;
             if (!calibrated())
                 return "not calibrated (run everytouch-calib calibrate)";
+            if (pattern_.empty() && cameraRig_)
+                return "not detecting (the projected code is not known: set [Projector] Output=external "
+                       "for a projector that embeds it, see everytouchd.conf(5))";
             return "not detecting (" + (loop_ ? loop_->idleReason() : std::string("no frames yet")) + ")";
         case DaemonState::Failed:
             return loop_ ? loop_->failure().value_or("") : std::string();
@@ -479,6 +515,7 @@ void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
     if (outcome.ok) {
         store_->activate(*outcome.calibration);
         drawDisplayThrough(*outcome.calibration);
+        adoptExternalCode(*outcome.calibration);
         ET_LOG(Notice) << outcome.message << "; SaveCalibration keeps it";
     } else {
         ET_LOG(Warning) << "calibration failed: " << outcome.message
@@ -531,6 +568,7 @@ void Daemon::reloadConfig() {
         {options_.rig.empty() && fresh.rig != config_.rig, "[Camera] Rig"},
         {fresh.uinput != config_.uinput, "[Output] Uinput"},
         {fresh.calibrationPath != config_.calibrationPath, "[Calibration] Path"},
+        {fresh.projector != config_.projector, "[Projector]"},
     };
     for (const auto& [changed, key] : restartOnly)
         if (changed)

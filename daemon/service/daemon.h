@@ -91,6 +91,10 @@ private:
     // Has the projector draw the desktop through the keystone of `calibration`, the one now active, as the
     // touches are mapped through it. A recording shows what it was recorded showing.
     void drawDisplayThrough(const core::Calibration& calibration);
+    // On a camera rig whose projector embeds the code itself ([Projector] Output=external): the code is the
+    // pattern of the configured seed at the calibration's projector size, also written beside the
+    // calibration file for the projector's side.
+    void adoptExternalCode(const core::Calibration& calibration);
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
     void startFrameLoop(std::vector<io::TouchSink*> sinks);

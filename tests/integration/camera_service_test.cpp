@@ -14,6 +14,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/pattern.h"
+#include "io/calibration_file.h"
+#include "sim/rig_geometry.h"
 #include "support/bus_commands.h"
 #include "support/fake_gige_camera.h"
 #include "support/notify_socket.h"
@@ -57,12 +60,15 @@ protected:
             std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
     }
 
-    // Starts everytouchd on the camera with `cameraKeys` in [Camera]; it has no virtual touchscreen here.
-    void startDaemon(const std::string& cameraKeys) {
+    // Starts everytouchd on the camera with `cameraKeys` in [Camera] and `moreSections` after the others; it
+    // has no virtual touchscreen here.
+    void startDaemon(const std::string& cameraKeys, const std::string& moreSections = "") {
         std::ofstream(dir_ / "everytouchd.conf")
             << "[Camera]\nRig=aravis:" << test::FakeGigeCamera::kAddress << "\n"
             << cameraKeys
-            << "[Output]\nUinput=no\n[Calibration]\nPath=" << (dir_ / "calibration.yml").string() << "\n";
+            << "[Output]\nUinput=no\n[Calibration]\nPath=" << (dir_ / "calibration.yml").string() << "\n"
+            << moreSections;
+        notify_.reset();  // a daemon started before has its socket
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
         daemon_ = std::make_unique<test::BackgroundProcess>(
             std::vector<std::string>{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string()},
@@ -159,6 +165,41 @@ TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARe
     EXPECT_TRUE(daemon_->running());
     EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent after it came back";
     EXPECT_EQ(get("StateReason"), "s \"not calibrated (run everytouch-calib calibrate)\"\n");
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+}
+
+TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeedWrittenBesideTheCalibration) {
+    // The calibration of the simulated rig with this camera's sensor.
+    sim::SimParameters rig;
+    rig.cameraSize = cv::Size(320, 240);
+    io::writeCalibrationFile(dir_ / "calibration.yml", sim::rigCalibration(rig));
+
+    // Calibrated, but nothing says what the projector shows.
+    startDaemon("PixelFormat=Mono8\nFrameRate=30\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    EXPECT_THAT(get("StateReason"),
+                HasSubstr("the projected code is not known: set [Projector] Output=external"));
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "pattern.png"));
+    daemon_->signal(SIGTERM);
+    ASSERT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+
+    startDaemon("PixelFormat=Mono8\nFrameRate=30\n", "[Projector]\nOutput=external\nSeed=7\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    // Detection runs on the camera's pairs: the ramp it films shows no hand, and no code either, which
+    // is not a fault.
+    std::string state;
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline && (state = get("State")) != "s \"running\"\n")
+        std::this_thread::sleep_for(100ms);
+    EXPECT_EQ(state, "s \"running\"\n") << get("StateReason");
+    core::PatternOptions pattern;
+    pattern.size = rig.projectorSize;
+    pattern.seed = 7;
+    const cv::Mat written = cv::imread((dir_ / "pattern.png").string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(written.type(), CV_8UC1) << "no pattern.png beside the calibration";
+    EXPECT_EQ(cv::norm(written, core::generatePattern(pattern) * 255, cv::NORM_INF), 0.0);
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
 }

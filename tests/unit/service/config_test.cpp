@@ -1,6 +1,8 @@
 #include "service/config.h"
 
+#include <cstdint>
 #include <fstream>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -42,7 +44,8 @@ TEST(Config, ReadsEveryKey) {
     write(dir / "everytouchd.conf",
           "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
           "[Calibration]\nPath=/var/lib/et/cal.yml\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
-          "ExposureUs=4000\nGainDb=6\nRegion=640x480+16+8\nTrigger=Line1\n");
+          "ExposureUs=4000\nGainDb=6\nRegion=640x480+16+8\nTrigger=Line1\n"
+          "[Projector]\nOutput=external\nSeed=18446744073709551615\n");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
     EXPECT_EQ(config.rig, "replay:/srv/rec");
     EXPECT_EQ(config.camera, (io::CameraSettings{io::CameraPixels::BayerGr8, 119.5, 4000.0, 6.0,
@@ -50,6 +53,8 @@ TEST(Config, ReadsEveryKey) {
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
+    EXPECT_EQ(config.projector,
+              (ProjectorConfig{ProjectorOutput::External, std::numeric_limits<std::uint64_t>::max()}));
 }
 
 TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
@@ -109,6 +114,11 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
          ":2: [Camera] Region: must be at least 64 pixels wide and high, found 32x480"},
         {"[Camera]\nTrigger=Line 0\n",
          ":2: [Camera] Trigger: expected off or a trigger source such as Line0"},
+        {"[Projector]\nOutput=dlp\n", ":2: [Projector] Output: expected none or external, found \"dlp\""},
+        {"[Projector]\nOutput=window\n",
+         ":2: [Projector] Output: window is not part of this build yet; it knows none and external"},
+        {"[Projector]\nSeed=-1\n", ":2: [Projector] Seed: expected a whole number from 0 to"},
+        {"[Projector]\nSeed=18446744073709551616\n", ":2: [Projector] Seed: expected a whole number"},
     };
     for (const auto& [text, expected] : cases) {
         write(dir / "everytouchd.conf", text);
