@@ -2,14 +2,19 @@
 // the daemon as a separate process on a private system bus, as a service would run it.
 #include <signal.h>
 
+#include <atomic>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <thread>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -17,6 +22,7 @@
 #include "core/pattern.h"
 #include "io/calibration_file.h"
 #include "sim/rig_geometry.h"
+#include "sim/simulator.h"
 #include "support/bus_commands.h"
 #include "support/fake_gige_camera.h"
 #include "support/notify_socket.h"
@@ -71,7 +77,8 @@ protected:
         notify_.reset();  // a daemon started before has its socket
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
         daemon_ = std::make_unique<test::BackgroundProcess>(
-            std::vector<std::string>{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string()},
+            std::vector<std::string>{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string(),
+                                     "--log", (dir_ / "touch.log").string()},
             dir_ / "everytouchd.log",
             std::vector<std::pair<std::string, std::string>>{{"NOTIFY_SOCKET", notify_->path().string()}});
     }
@@ -202,6 +209,80 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
     EXPECT_EQ(cv::norm(written, core::generatePattern(pattern) * 255, cv::NORM_INF), 0.0);
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+}
+
+// The first touch-down of a touch log (JSON Lines): frame index and position in display pixels.
+struct TouchDown {
+    std::uint64_t index = 0;
+    double x = 0.0, y = 0.0;
+};
+
+std::optional<TouchDown> firstTouchDown(const std::filesystem::path& log) {
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) {
+        const nlohmann::json entry = nlohmann::json::parse(line, nullptr, false);
+        if (entry.is_discarded() || !entry.contains("contacts"))
+            continue;
+        for (const nlohmann::json& contact : entry["contacts"])
+            if (contact.value("touch", false))
+                return TouchDown{entry["index"].get<std::uint64_t>(), contact["x"].get<double>(),
+                                 contact["y"].get<double>()};
+    }
+    return std::nullopt;
+}
+
+TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
+    // The camera films the simulated rig's grid35 from 1 s on, a frame of the simulation per camera frame,
+    // as RGB8 over GVSP; the daemon knows the rig's calibration and, as from a projector that embeds the
+    // code itself, the pattern of its seed.
+    sim::SimParameters rig;
+    rig.scenario = "grid35";
+    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
+    io::writeCalibrationFile(dir_ / "calibration.yml", simulator->calibration());
+    constexpr std::uint64_t kFirstSimulatedFrame = 120;
+    auto firstFrameId = std::make_shared<std::atomic<std::int64_t>>(-1);
+    camera_.reset();
+    camera_ = std::make_unique<test::FakeGigeCamera>(
+        rig.cameraSize, [simulator, firstFrameId](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+            std::int64_t unset = -1;
+            firstFrameId->compare_exchange_strong(unset, static_cast<std::int64_t>(frameId));
+            core::Frame frame;
+            sim::FrameTruth truth;
+            simulator->render(
+                kFirstSimulatedFrame + frameId - static_cast<std::uint64_t>(firstFrameId->load()), frame,
+                truth);
+            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
+        });
+    // 20 frames/s leaves the rendering and the pipeline time to spare under the sanitizers too, so that no
+    // frame is dropped and the daemon pairs the frames the simulated rig's run pairs.
+    startDaemon("PixelFormat=RGB8\nFrameRate=20\n", "[Projector]\nOutput=external\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+
+    // The simulated rig's own run over the same frames touches down at frame 204: 84 camera frames in.
+    std::optional<TouchDown> touchDown;
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline && !(touchDown = firstTouchDown(dir_ / "touch.log")))
+        std::this_thread::sleep_for(100ms);
+    ASSERT_TRUE(touchDown) << "no touch in the touch log; StateReason " << get("StateReason");
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+    const std::string dropped = get("DroppedFrames");
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+
+    // Where the simulated rig's own pipeline puts it, over the same pairs.
+    const test::ProcessResult simulated =
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "sim:grid35", "--fast", "--frames", "260", "--log",
+                          (dir_ / "simulated.log").string()});
+    ASSERT_EQ(simulated.exitCode, 0) << simulated.err;
+    const std::optional<TouchDown> expected = firstTouchDown(dir_ / "simulated.log");
+    ASSERT_TRUE(expected);
+    RecordProperty("touch_down_frame", std::to_string(touchDown->index));
+    RecordProperty("touch_down_offset_px",
+                   std::to_string(std::hypot(touchDown->x - expected->x, touchDown->y - expected->y)));
+    EXPECT_EQ(kFirstSimulatedFrame + touchDown->index, expected->index) << "DroppedFrames " << dropped;
+    EXPECT_NEAR(touchDown->x, expected->x, 1.0) << "DroppedFrames " << dropped;
+    EXPECT_NEAR(touchDown->y, expected->y, 1.0) << "DroppedFrames " << dropped;
 }
 
 TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {
