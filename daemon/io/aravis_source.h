@@ -40,6 +40,7 @@ public:
     // A camera describes only itself: the calibration store and the projector side know the rest.
     std::optional<RigDescription> rig() const override { return std::nullopt; }
     std::string describe() const override { return description_; }
+    double frameRate() const override { return frameRate_; }
     std::uint64_t droppedFrames() const override { return dropped_.load(); }
 
     // How long next() waits for a frame before the camera counts as lost: ten frame periods, at least half a

@@ -46,6 +46,10 @@ public:
 
     virtual std::string describe() const = 0;
 
+    // The frames per second a camera runs at, as it says; 0 when it does not (a trigger, a rig that
+    // describes itself).
+    virtual double frameRate() const { return 0.0; }
+
     // Frames the source lost before they reached `next` (a camera's incomplete or skipped frames); safe to
     // call from any thread.
     virtual std::uint64_t droppedFrames() const { return 0; }

@@ -33,6 +33,7 @@ public:
     // later call until the node opens again with its settings.
     std::optional<RigDescription> rig() const override { return std::nullopt; }
     std::string describe() const override { return description_; }
+    double frameRate() const override { return frameRate_; }
     std::uint64_t droppedFrames() const override { return dropped_.load(); }
 
     // How long next() waits for a frame before the camera counts as lost: ten frame periods, at least half a

@@ -170,6 +170,19 @@ const std::vector<KeySpec>& keySpecs() {
              else
                  throw BadValue{"expected none or external, found \"" + value + "\""};
          }},
+        {"Projector", "Delta",
+         [](DaemonConfig& config, const std::string& value) {
+             if (value.empty()) {
+                 config.projector.delta = ProjectorConfig().delta;
+                 return;
+             }
+             int delta = 0;
+             const char* end = value.data() + value.size();
+             const auto [stop, error] = std::from_chars(value.data(), end, delta);
+             if (error != std::errc() || stop != end || delta < 1 || delta > 127)
+                 throw BadValue{"expected a whole number of levels from 1 to 127, found \"" + value + "\""};
+             config.projector.delta = delta;
+         }},
         {"Projector", "Seed",
          [](DaemonConfig& config, const std::string& value) {
              if (value.empty()) {

@@ -35,6 +35,7 @@ enum class ProjectorOutput { None, External };
 struct ProjectorConfig {
     ProjectorOutput output = ProjectorOutput::None;  // [Projector] Output=
     std::uint64_t seed = 1;                          // [Projector] Seed=: the pattern's seed
+    int delta = 10;  // [Projector] Delta=: its amplitude, projector levels (what a recording states)
 
     bool operator==(const ProjectorConfig&) const = default;
 };

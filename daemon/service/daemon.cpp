@@ -112,9 +112,14 @@ int Daemon::run() {
 
     if (!options_.recordDir.empty()) {
         // The rig as it is now, its display drawn through the active calibration's keystone.
-        const std::optional<io::RigDescription> recorded = source_->rig();
+        const std::optional<io::RigDescription> recorded = recordedRig();
         if (!recorded)
-            throw io::InputError("--record", "", "this rig does not describe itself; calibrate it first");
+            throw io::InputError("--record", "",
+                                 cameraRig_
+                                     ? "a camera rig is recorded once it is calibrated, knows its code "
+                                       "([Projector] Output=external) and says its frame rate "
+                                       "([Camera] FrameRate=)"
+                                     : "this rig does not describe itself; calibrate it first");
         const bool withTruth = source_->truth().has_value();
         const bool withMasks = source_->truthMask().has_value();
         recorder_ =
@@ -161,6 +166,16 @@ void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
         drawDisplayThrough(*store_->active());
         adoptExternalCode(*store_->active());
     }
+}
+
+std::optional<io::RigDescription> Daemon::recordedRig() const {
+    if (std::optional<io::RigDescription> rig = source_->rig())
+        return rig;
+    const double frameRate =
+        source_->frameRate() > 0.0 ? source_->frameRate() : config_.camera.frameRate.value_or(0.0);
+    if (!cameraRig_ || !store_->active() || pattern_.empty() || !(frameRate > 0.0))
+        return std::nullopt;
+    return io::RigDescription{*store_->active(), config_.projector.delta, frameRate, pattern_};
 }
 
 void Daemon::adoptExternalCode(const core::Calibration& calibration) {

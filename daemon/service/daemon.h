@@ -95,6 +95,9 @@ private:
     // pattern of the configured seed at the calibration's projector size, also written beside the
     // calibration file for the projector's side.
     void adoptExternalCode(const core::Calibration& calibration);
+    // What a recording says of the rig: its own description, or a camera rig's calibration, code and frame
+    // rate once all are known.
+    std::optional<io::RigDescription> recordedRig() const;
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
     void startFrameLoop(std::vector<io::TouchSink*> sinks);

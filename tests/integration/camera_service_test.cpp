@@ -66,9 +66,10 @@ protected:
             std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
     }
 
-    // Starts everytouchd on the camera with `cameraKeys` in [Camera] and `moreSections` after the others; it
-    // has no virtual touchscreen here.
-    void startDaemon(const std::string& cameraKeys, const std::string& moreSections = "") {
+    // Starts everytouchd on the camera with `cameraKeys` in [Camera], `moreSections` after the others and
+    // `moreArguments` on its command line; it has no virtual touchscreen here.
+    void startDaemon(const std::string& cameraKeys, const std::string& moreSections = "",
+                     const std::vector<std::string>& moreArguments = {}) {
         std::ofstream(dir_ / "everytouchd.conf")
             << "[Camera]\nRig=aravis:" << test::FakeGigeCamera::kAddress << "\n"
             << cameraKeys
@@ -76,10 +77,11 @@ protected:
             << moreSections;
         notify_.reset();  // a daemon started before has its socket
         notify_ = std::make_unique<test::NotifySocket>(dir_ / "notify.socket");
+        std::vector<std::string> arguments{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string(),
+                                           "--log", (dir_ / "touch.log").string()};
+        arguments.insert(arguments.end(), moreArguments.begin(), moreArguments.end());
         daemon_ = std::make_unique<test::BackgroundProcess>(
-            std::vector<std::string>{EVERYTOUCHD_PATH, "--config", (dir_ / "everytouchd.conf").string(),
-                                     "--log", (dir_ / "touch.log").string()},
-            dir_ / "everytouchd.log",
+            arguments, dir_ / "everytouchd.log",
             std::vector<std::pair<std::string, std::string>>{{"NOTIFY_SOCKET", notify_->path().string()}});
     }
 
@@ -256,7 +258,8 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
         });
     // 20 frames/s leaves the rendering and the pipeline time to spare under the sanitizers too, so that no
     // frame is dropped and the daemon pairs the frames the simulated rig's run pairs.
-    startDaemon("PixelFormat=RGB8\nFrameRate=20\n", "[Projector]\nOutput=external\n");
+    startDaemon("PixelFormat=RGB8\nFrameRate=20\n", "[Projector]\nOutput=external\n",
+                {"--record", (dir_ / "recording").string()});
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
 
     // The simulated rig's own run over the same frames touches down at frame 204: 84 camera frames in.
@@ -283,6 +286,17 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
     EXPECT_EQ(kFirstSimulatedFrame + touchDown->index, expected->index) << "DroppedFrames " << dropped;
     EXPECT_NEAR(touchDown->x, expected->x, 1.0) << "DroppedFrames " << dropped;
     EXPECT_NEAR(touchDown->y, expected->y, 1.0) << "DroppedFrames " << dropped;
+
+    // The camera's recording, replayed, touches down as the camera did.
+    const test::ProcessResult replayed =
+        test::runProcess({EVERYTOUCHD_PATH, "--rig", "replay:" + (dir_ / "recording").string(), "--fast",
+                          "--log", (dir_ / "replayed.log").string()});
+    ASSERT_EQ(replayed.exitCode, 0) << replayed.err;
+    const std::optional<TouchDown> again = firstTouchDown(dir_ / "replayed.log");
+    ASSERT_TRUE(again) << "the recording's replay has no touch";
+    EXPECT_EQ(again->index, touchDown->index);
+    EXPECT_NEAR(again->x, touchDown->x, 1.0);
+    EXPECT_NEAR(again->y, touchDown->y, 1.0);
 }
 
 TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {

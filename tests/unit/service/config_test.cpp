@@ -45,7 +45,7 @@ TEST(Config, ReadsEveryKey) {
           "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
           "[Calibration]\nPath=/var/lib/et/cal.yml\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
           "ExposureUs=4000\nGainDb=6\nRegion=640x480+16+8\nTrigger=Line1\n"
-          "[Projector]\nOutput=external\nSeed=18446744073709551615\n");
+          "[Projector]\nOutput=external\nSeed=18446744073709551615\nDelta=12\n");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
     EXPECT_EQ(config.rig, "replay:/srv/rec");
     EXPECT_EQ(config.camera, (io::CameraSettings{io::CameraPixels::BayerGr8, 119.5, 4000.0, 6.0,
@@ -54,7 +54,7 @@ TEST(Config, ReadsEveryKey) {
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
     EXPECT_EQ(config.projector,
-              (ProjectorConfig{ProjectorOutput::External, std::numeric_limits<std::uint64_t>::max()}));
+              (ProjectorConfig{ProjectorOutput::External, std::numeric_limits<std::uint64_t>::max(), 12}));
 }
 
 TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
@@ -119,6 +119,10 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
          ":2: [Projector] Output: window is not part of this build yet; it knows none and external"},
         {"[Projector]\nSeed=-1\n", ":2: [Projector] Seed: expected a whole number from 0 to"},
         {"[Projector]\nSeed=18446744073709551616\n", ":2: [Projector] Seed: expected a whole number"},
+        {"[Projector]\nDelta=0\n",
+         ":2: [Projector] Delta: expected a whole number of levels from 1 to 127, found \"0\""},
+        {"[Projector]\nDelta=128\n", ":2: [Projector] Delta: expected a whole number of levels"},
+        {"[Projector]\nDelta=9.5\n", ":2: [Projector] Delta: expected a whole number of levels"},
     };
     for (const auto& [text, expected] : cases) {
         write(dir / "everytouchd.conf", text);
