@@ -219,6 +219,16 @@ struct TouchDown {
     double x = 0.0, y = 0.0;
 };
 
+// The last entry of a touch log, parsed.
+nlohmann::json lastEntry(const std::filesystem::path& log) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line))
+        if (!line.empty())
+            last = line;
+    return nlohmann::json::parse(last, nullptr, false);
+}
+
 std::optional<TouchDown> firstTouchDown(const std::filesystem::path& log) {
     std::ifstream in(log);
     std::string line;
@@ -262,7 +272,8 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
                 {"--record", (dir_ / "recording").string()});
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
 
-    // The simulated rig's own run over the same frames touches down at frame 204: 84 camera frames in.
+    // The simulated rig's own run over the same frames touches down at frame 204: 84 camera frames in, and
+    // lifts at frame 250.
     std::optional<TouchDown> touchDown;
     const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
     while (std::chrono::steady_clock::now() < deadline && !(touchDown = firstTouchDown(dir_ / "touch.log")))
@@ -270,6 +281,17 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
     ASSERT_TRUE(touchDown) << "no touch in the touch log; StateReason " << get("StateReason");
     EXPECT_EQ(get("State"), "s \"running\"\n");
     const std::string dropped = get("DroppedFrames");
+
+    // The cable pulled while the finger touches (the tap lasts 46 frames, 2.3 s): the camera is lost within
+    // half a second, the finger released, and the daemon waits for the camera. (Stopping then takes some
+    // 10 s: Aravis lets go of a GigE camera that no longer answers only after its protocol's timeouts.)
+    camera_->unplug();
+    ASSERT_TRUE(waitForStatus("STATUS=Camera lost")) << "the status does not say the camera is lost";
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    const nlohmann::json last = lastEntry(dir_ / "touch.log");
+    ASSERT_TRUE(last.contains("contacts")) << last.dump();
+    EXPECT_TRUE(last["contacts"].empty())
+        << "a contact stays down after the camera was lost: " << last.dump();
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
 
