@@ -528,6 +528,22 @@ const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx)
     return feature.val;
 }
 
+template <typename IsSample>
+float HandSegmenter::nearestTableColour(const cv::Mat& texture, int block, int reach, IsSample isSample) {
+    float& nearest = tableDistance_[static_cast<std::size_t>(block)];
+    if (nearest >= 0.0f)
+        return nearest;
+    const int rows = blockClass_.rows, cols = blockClass_.cols;
+    const int y = block / cols, x = block % cols;
+    const float* colour = blockFeature(texture, y, x);
+    nearest = std::numeric_limits<float>::max();
+    for (int ty = std::max(y - reach, 0); ty <= std::min(y + reach, rows - 1); ++ty)
+        for (int tx = std::max(x - reach, 0); tx <= std::min(x + reach, cols - 1); ++tx)
+            if (isSample(ty * cols + tx))
+                nearest = std::min(nearest, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
+    return nearest;
+}
+
 void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
     const int rows = blockClass_.rows, cols = blockClass_.cols;
     uchar* classes = blockClass_.ptr<uchar>();
@@ -550,18 +566,8 @@ void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
                 const int j = ny * cols + nx;
                 const float* colour = blockFeature(texture, ny, nx);
                 const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
-                float& tableDistance = tableDistance_[static_cast<std::size_t>(j)];
-                if (tableDistance < 0.0f) {
-                    tableDistance = std::numeric_limits<float>::max();
-                    for (int ty = std::max(ny - kTableReach, 0); ty <= std::min(ny + kTableReach, rows - 1);
-                         ++ty)
-                        for (int tx = std::max(nx - kTableReach, 0);
-                             tx <= std::min(nx + kTableReach, cols - 1); ++tx)
-                            if (classes[ty * cols + tx] == Table)
-                                tableDistance =
-                                    std::min(tableDistance,
-                                             featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
-                }
+                const float tableDistance =
+                    nearestTableColour(texture, j, kTableReach, [&](int k) { return classes[k] == Table; });
                 if (handDistance < tableDistance) {
                     classes[j] = Grown;
                     queue_[tail++] = j;
@@ -629,20 +635,9 @@ void HandSegmenter::growOverTouchingSkin(const cv::Mat& texture) {
                     continue;
                 const float* colour = blockFeature(texture, ny, nx);
                 const float handDistance = featureDistanceSquared(colour, blockFeature(texture, y, x));
-                float& tableDistance = tableDistance_[static_cast<std::size_t>(j)];
-                if (tableDistance < 0.0f) {
-                    tableDistance = std::numeric_limits<float>::max();
-                    for (int ty = std::max(ny - sampleReach, 0); ty <= std::min(ny + sampleReach, rows - 1);
-                         ++ty)
-                        for (int tx = std::max(nx - sampleReach, 0);
-                             tx <= std::min(nx + sampleReach, cols - 1); ++tx) {
-                            const int k = ty * cols + tx;
-                            if (classes[k] == Table && blocksToHand_[k] > reach)
-                                tableDistance =
-                                    std::min(tableDistance,
-                                             featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
-                        }
-                }
+                const float tableDistance = nearestTableColour(texture, j, sampleReach, [&](int k) {
+                    return classes[k] == Table && blocksToHand_[k] > reach;
+                });
                 if (kTouchingColourRatio * handDistance < tableDistance &&
                     tableDistance < std::numeric_limits<float>::max()) {
                     classes[j] = Candidate;  // until the size of what grew is known

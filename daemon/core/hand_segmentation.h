@@ -107,6 +107,11 @@ private:
     bool liesOnTable(const cv::Mat& subtraction, int size);
     // A block's mean colour as colourFeature makes it, measured on first use in a frame.
     const float* blockFeature(const cv::Mat& texture, int by, int bx);
+    // The squared colour distance from block `block` to the nearest block within `reach` that isSample(index)
+    // takes as the table's, or the largest float without one: measured once per growth step (tableDistance_,
+    // which the step clears), since a block beside several hand blocks is judged from each.
+    template <typename IsSample>
+    float nearestTableColour(const cv::Mat& texture, int block, int reach, IsSample isSample);
     void growIntoFaintBlocks(const cv::Mat& texture);
     void growOverTouchingSkin(const cv::Mat& texture);
     // handBox_ receives the box of the hand's blocks (empty without any).
@@ -138,11 +143,8 @@ private:
     std::vector<float> values_;
     std::vector<int> queue_;
     std::vector<int> component_;
-    std::vector<int> blocksToHand_;  // block grid: blocks to the nearest hand block (8-connected)
-    // Block grid: a block's squared colour distance to the nearest table sample around it, as one growth
-    // step samples the table (negative until computed): a block next to several hand blocks is judged
-    // against the same table from each of them.
-    std::vector<float> tableDistance_;
+    std::vector<int> blocksToHand_;     // block grid: blocks to the nearest hand block (8-connected)
+    std::vector<float> tableDistance_;  // block grid: nearestTableColour's, negative until measured
     MajorityScratch majorityScratch_;
     SurfaceHeight elevation_;
     HeightEvidence elevationEvidence_;

@@ -259,6 +259,13 @@ cv::Mat Recording::loadMask(std::size_t position) const {
                            "camera size");
 }
 
+void writePatternImage(const std::filesystem::path& path, const cv::Mat& pattern) {
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", pattern * 255, png))
+        throw InputError(path.string(), "", "cannot be encoded as PNG");
+    writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
 RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const RigDescription& rig,
                                  bool withTruth, bool withMasks)
     : directory_(directory), cameraSize_(rig.calibration.cameraSize), withMasks_(withMasks) {
@@ -277,8 +284,7 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const R
     storage << "delta" << rig.delta << "frame_rate" << rig.frameRate << "pattern"
             << "pattern.png";
     writeFileAtomically(directory / "rig.yml", storage.releaseAndGetString());
-    if (!cv::imwrite((directory / "pattern.png").string(), rig.pattern * 255))
-        throw InputError((directory / "pattern.png").string(), "", "cannot be written");
+    writePatternImage(directory / "pattern.png", rig.pattern);
 
     const auto openTable = [&](const char* name, std::string_view header, UniqueFd& table, off_t& size) {
         const std::filesystem::path path = directory / name;

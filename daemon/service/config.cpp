@@ -8,8 +8,10 @@
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <regex>
+#include <string>
 #include <vector>
 
 #include "io/handles.h"
@@ -58,6 +60,18 @@ double parseQuantity(const std::string& text, double minimum, double maximum, co
         std::snprintf(range, sizeof range, "%g to %g", minimum, maximum);
         throw BadValue{"must be from " + std::string(range) + " " + unitSymbol + ", found " + text};
     }
+    return value;
+}
+
+// A whole number from `minimum` to `maximum`; `what` names it for the message ("a whole number of levels").
+template <typename Integer>
+Integer parseWholeNumber(const std::string& text, Integer minimum, Integer maximum, const std::string& what) {
+    Integer value = 0;
+    const char* end = text.data() + text.size();
+    const auto [stop, error] = std::from_chars(text.data(), end, value);
+    if (error != std::errc() || stop != end || value < minimum || value > maximum)
+        throw BadValue{"expected " + what + " from " + std::to_string(minimum) + " to " +
+                       std::to_string(maximum) + ", found \"" + text + "\""};
     return value;
 }
 
@@ -172,30 +186,17 @@ const std::vector<KeySpec>& keySpecs() {
          }},
         {"Projector", "Delta",
          [](DaemonConfig& config, const std::string& value) {
-             if (value.empty()) {
-                 config.projector.delta = ProjectorConfig().delta;
-                 return;
-             }
-             int delta = 0;
-             const char* end = value.data() + value.size();
-             const auto [stop, error] = std::from_chars(value.data(), end, delta);
-             if (error != std::errc() || stop != end || delta < 1 || delta > 127)
-                 throw BadValue{"expected a whole number of levels from 1 to 127, found \"" + value + "\""};
-             config.projector.delta = delta;
+             config.projector.delta = value.empty()
+                                          ? ProjectorConfig().delta
+                                          : parseWholeNumber(value, 1, 127, "a whole number of levels");
          }},
         {"Projector", "Seed",
          [](DaemonConfig& config, const std::string& value) {
-             if (value.empty()) {
-                 config.projector.seed = ProjectorConfig().seed;
-                 return;
-             }
-             std::uint64_t seed = 0;
-             const char* end = value.data() + value.size();
-             const auto [stop, error] = std::from_chars(value.data(), end, seed);
-             if (error != std::errc() || stop != end)
-                 throw BadValue{"expected a whole number from 0 to 18446744073709551615, found \"" + value +
-                                "\""};
-             config.projector.seed = seed;
+             config.projector.seed =
+                 value.empty()
+                     ? ProjectorConfig().seed
+                     : parseWholeNumber(value, std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max(),
+                                        "a whole number");
          }},
     };
     return specs;

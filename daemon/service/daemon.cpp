@@ -11,10 +11,7 @@
 #include <cstring>
 #include <system_error>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "core/pattern.h"
-#include "io/atomic_file.h"
 #include "io/input_error.h"
 #include "io/log.h"
 #include "service/bus_names.h"
@@ -194,10 +191,7 @@ void Daemon::adoptExternalCode(const core::Calibration& calibration) {
     // Beside the calibration, for the projector's side to show (255 on 1-bits, as a recording's pattern.png).
     const std::filesystem::path file = store_->path().parent_path() / "pattern.png";
     try {
-        std::vector<uchar> png;
-        cv::imencode(".png", pattern_ * 255, png);
-        io::writeFileAtomically(file,
-                                std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+        io::writePatternImage(file, pattern_);
         ET_LOG(Info) << "code: the pattern written to " << file.string();
     } catch (const std::exception& error) {
         ET_LOG(Warning) << "code: the pattern could not be written to " << file.string() << ": "

@@ -12,6 +12,7 @@
 #include "core/polarity_lock.h"
 #include "core/touch_pipeline.h"
 #include "sim/simulator.h"
+#include "support/simulated_rig_settings.h"
 
 namespace everytouch::core {
 namespace {
@@ -101,14 +102,6 @@ TEST_F(PolarityLockTest, APairWithoutCodeChangesNothing) {
     EXPECT_FALSE(lock.swapped());
 }
 
-PipelineSettings settingsOf(const sim::Simulator& simulator) {
-    PipelineSettings settings;
-    settings.calibration = simulator.calibration();
-    settings.pattern = simulator.pattern();
-    settings.touchHeightMm = 3.0;
-    return settings;
-}
-
 // Labels the frames as a camera that counts them does: by their place among those delivered, starting
 // with `first`.
 std::vector<Frame> asCounted(std::vector<Frame> frames, Polarity first) {
@@ -122,7 +115,7 @@ std::vector<Frame> asCounted(std::vector<Frame> frames, Polarity first) {
 
 TEST(TouchPipelinePolarity, ACameraThatStartedOnTheOtherFrameSeesTheSameTouches) {
     const Rendered& scene = rendered();
-    const PipelineSettings settings = settingsOf(*scene.simulator);
+    const PipelineSettings settings = test::simulatedRigSettings(*scene.simulator);
     const std::vector<Frame> right = asCounted(scene.frames, scene.frames[0].polarity);
     const std::vector<Frame> wrong = asCounted(scene.frames, opposite(scene.frames[0].polarity));
     TouchPipeline labelledRight, labelledWrong;
@@ -148,7 +141,7 @@ TEST(TouchPipelinePolarity, ACameraThatStartedOnTheOtherFrameSeesTheSameTouches)
 std::vector<std::vector<std::uint32_t>> touchingIds(const std::vector<Frame>& delivered,
                                                     const std::vector<std::uint64_t>& renderedIndex,
                                                     std::uint64_t* swaps) {
-    const PipelineSettings settings = settingsOf(*rendered().simulator);
+    const PipelineSettings settings = test::simulatedRigSettings(*rendered().simulator);
     TouchPipeline pipeline;
     std::vector<std::vector<std::uint32_t>> touching;
     for (std::size_t i = 1; i < delivered.size(); ++i) {

@@ -8,6 +8,7 @@
 
 #include "core/touch_pipeline.h"
 #include "sim/simulator.h"
+#include "support/simulated_rig_settings.h"
 
 namespace everytouch::core {
 namespace {
@@ -18,15 +19,6 @@ struct DragScore {
     int touchingFrames = 0;  // of those, frames with a touching contact
     int touchDowns = 0;      // contacts that went down while a finger lay on the table
 };
-
-// What the daemon gives the pipeline on the simulated rig.
-PipelineSettings rigSettings(const sim::Simulator& simulator) {
-    PipelineSettings settings;
-    settings.calibration = simulator.calibration();
-    settings.pattern = simulator.pattern();
-    settings.touchHeightMm = 3.0;
-    return settings;
-}
 
 // The pipeline on two consecutive frames, whichever of them shows O + P.
 const PipelineResult& processInOrder(TouchPipeline& pipeline, const Frame& older, const Frame& newer,
@@ -41,7 +33,7 @@ DragScore scoreDrags(const std::string& scenario) {
     parameters.scenario = scenario;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    const PipelineSettings settings = rigSettings(simulator);
+    const PipelineSettings settings = test::simulatedRigSettings(simulator);
 
     DragScore score;
     Frame older, newer;
@@ -95,7 +87,7 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     parameters.scenario = "grid35";
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    const PipelineSettings settings = rigSettings(simulator);
+    const PipelineSettings settings = test::simulatedRigSettings(simulator);
     HandSegmenter segmenter(SegmentationOptions{});
     segmenter.setRig(*settings.calibration, settings.pattern);
 
@@ -138,7 +130,7 @@ TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
     parameters.startS = 1.4;  // the first tap touches from 1.7 s on
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     TouchPipeline pipeline;
-    const PipelineSettings settings = rigSettings(simulator);
+    const PipelineSettings settings = test::simulatedRigSettings(simulator);
     const auto centreQuarter = [](const Frame& frame) {
         Frame cropped = frame;
         const cv::Size size = frame.image.size();
