@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 packages=(
     build-essential cmake pkg-config clang-format
     libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
-    libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools
+    libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools libsdl2-dev xvfb
     libcli11-dev nlohmann-json3-dev libinih-dev scdoc mandoc lintian
     dbus systemd udev
     qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils

@@ -179,11 +179,15 @@ const std::vector<KeySpec>& keySpecs() {
                  config.projector.output = ProjectorOutput::None;
              else if (value == "external")
                  config.projector.output = ProjectorOutput::External;
-             else if (value == "overlay" || value == "window")
-                 throw BadValue{value + " is not part of this build yet; it knows none and external"};
+             else if (value == "window")
+                 config.projector.output = ProjectorOutput::Window;
+             else if (value == "overlay")
+                 throw BadValue{value + " is not part of this build yet; it knows none, external and window"};
              else
-                 throw BadValue{"expected none or external, found \"" + value + "\""};
+                 throw BadValue{"expected none, external or window, found \"" + value + "\""};
          }},
+        {"Projector", "Display",
+         [](DaemonConfig& config, const std::string& value) { config.projector.display = value; }},
         {"Projector", "Delta",
          [](DaemonConfig& config, const std::string& value) {
              config.projector.delta = value.empty()

@@ -27,15 +27,17 @@ inline constexpr double kMaxGainDb = 60.0;
 // A camera region smaller than this cannot hold a display's worth of code.
 inline constexpr int kMinRegionSide = 64;
 
-// Where the code comes from on a camera rig ([Projector] Output=): nowhere the daemon knows of, or a
-// projector that embeds it itself (a DLP development kit's pattern sequence, a media server) from the pattern
-// of a seed.
-enum class ProjectorOutput { None, External };
+// Where the code comes from on a camera rig ([Projector] Output=): nowhere the daemon knows of, a projector
+// that embeds it itself (a DLP development kit's pattern sequence, a media server) from the pattern of a
+// seed, or the daemon's own fullscreen window on the projector's output, which also shows the calibration
+// images.
+enum class ProjectorOutput { None, External, Window };
 
 struct ProjectorConfig {
     ProjectorOutput output = ProjectorOutput::None;  // [Projector] Output=
     std::uint64_t seed = 1;                          // [Projector] Seed=: the pattern's seed
-    int delta = 10;  // [Projector] Delta=: its amplitude, projector levels (what a recording states)
+    int delta = 10;       // [Projector] Delta=: its amplitude, projector levels (what a recording states)
+    std::string display;  // [Projector] Display=: the window's output, by name or number; empty: the first
 
     bool operator==(const ProjectorConfig&) const = default;
 };

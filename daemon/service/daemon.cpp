@@ -76,6 +76,8 @@ void Daemon::prepareSignals() {
 
 int Daemon::run() {
     config_ = loadConfig(options_.configPath, options_.configPath != kDefaultConfigPath);
+    if (!options_.projector.empty())
+        applyProjectorOption(options_.projector, config_.projector);
     touchHeightMm_ = config_.touchHeightMm;
 
     std::string rigText = !options_.rig.empty() ? options_.rig : config_.rig;
@@ -91,15 +93,20 @@ int Daemon::run() {
     const io::RigSpec spec = io::RigSpec::parse(rigText);
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
-    OpenedRig opened = openRig(spec, options_.fast, config_.camera);
+    OpenedRig opened = openRig(spec, options_.fast, config_.camera, config_.projector);
     source_ = std::move(opened.source);
     projector_ = std::move(opened.projector);
+    pattern_ = std::move(opened.pattern);
     recordedRig_ = spec.kind == io::RigSpec::Kind::Replay;
     ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe()
                  << (projector_ ? ", calibration images on " + projector_->describe() : std::string());
     const std::optional<io::RigDescription> rig = source_->rig();
     if (rig)
         pattern_ = rig->pattern;
+    if (!pattern_.empty() && cameraRig_)
+        ET_LOG(Info) << "code: the pattern of seed " << config_.projector.seed << " on the projector's "
+                     << pattern_.cols << "x" << pattern_.rows << " pixels, " << config_.projector.delta
+                     << " levels, embedded by the projector window";
     if (projector_)
         projectorSize_ = projector_->size();
     else if (rig)
@@ -348,8 +355,9 @@ std::string Daemon::stateReason() const {
             if (!calibrated())
                 return "not calibrated (run everytouch-calib calibrate)";
             if (pattern_.empty() && cameraRig_)
-                return "not detecting (the projected code is not known: set [Projector] Output=external "
-                       "for a projector that embeds it, see everytouchd.conf(5))";
+                return "not detecting (the projected code is not known: set [Projector] Output=window for "
+                       "the daemon's own projector window, or external for a projector that embeds it, see "
+                       "everytouchd.conf(5))";
             return "not detecting (" + (loop_ ? loop_->idleReason() : std::string("no frames yet")) + ")";
         case DaemonState::Failed:
             return loop_ ? loop_->failure().value_or("") : std::string();
@@ -582,6 +590,7 @@ void Daemon::reloadConfig() {
     for (const auto& [changed, key] : restartOnly)
         if (changed)
             ET_LOG(Notice) << key << " changed: it takes effect when everytouchd restarts";
+    fresh.projector = config_.projector;  // the code on the table is the one the projector shows
     config_ = fresh;
     ET_LOG(Info) << "configuration reloaded from " << options_.configPath.string();
 }

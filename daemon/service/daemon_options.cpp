@@ -12,6 +12,14 @@ std::optional<std::string> DaemonOptions::validate() const {
     } catch (const io::InputError& error) {
         return error.what();
     }
+    try {
+        if (!projector.empty()) {
+            ProjectorConfig ignored;
+            applyProjectorOption(projector, ignored);
+        }
+    } catch (const io::InputError& error) {
+        return error.what();
+    }
     for (const std::string& output : outputs)
         if (output != "uinput")
             return "--output " + output + ": unknown output; the choice is uinput";
@@ -19,6 +27,25 @@ std::optional<std::string> DaemonOptions::validate() const {
         return "--record " + recordDir.string() +
                ": exists and is not empty; choose a new recording directory";
     return std::nullopt;
+}
+
+void applyProjectorOption(const std::string& option, ProjectorConfig& projector) {
+    const std::size_t colon = option.find(':');
+    const std::string output = option.substr(0, colon);
+    if (colon != std::string::npos && output != "window")
+        throw io::InputError("--projector", "",
+                             "only a window takes a display (window:DISPLAY), not \"" + option + "\"");
+    if (output == "none")
+        projector.output = ProjectorOutput::None;
+    else if (output == "external")
+        projector.output = ProjectorOutput::External;
+    else if (output == "window")
+        projector.output = ProjectorOutput::Window;
+    else
+        throw io::InputError("--projector", "",
+                             "expected none, external, window or window:DISPLAY, found \"" + option + "\"");
+    if (colon != std::string::npos)
+        projector.display = option.substr(colon + 1);
 }
 
 }  // namespace everytouch::service

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "service/config.h"
+
 #ifndef EVERYTOUCH_CONFIG_DIR
 #define EVERYTOUCH_CONFIG_DIR "/etc/everytouch"
 #endif
@@ -27,9 +29,14 @@ struct DaemonOptions {
     bool fast = false;                 // --fast: no real-time pacing for sim and replay rigs
     bool verbose = false;              // --verbose: debug logging, every contact change on stderr
     bool service = false;              // --service: run as the system service (no simulated fallback rig)
+    std::string projector;  // --projector: none, external or window[:DISPLAY]; empty: the configuration's
 
     // The first problem found, naming the option; nothing when the options are usable.
     std::optional<std::string> validate() const;
 };
+
+// Sets [Projector] Output= (and Display= for a window) from a --projector value: none, external,
+// window or window:DISPLAY. Throws io::InputError naming --projector for anything else.
+void applyProjectorOption(const std::string& option, ProjectorConfig& projector);
 
 }  // namespace everytouch::service

@@ -6,10 +6,24 @@
 #include "io/sim_projector.h"
 #include "io/sim_source.h"
 #include "io/v4l2_source.h"
+#include "io/window_projector.h"
 
 namespace everytouch::service {
 
-OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera) {
+namespace {
+
+void openCameraProjector(const ProjectorConfig& projector, OpenedRig& rig) {
+    if (projector.output != ProjectorOutput::Window)
+        return;
+    auto window = std::make_unique<io::WindowProjector>(projector.display, projector.seed, projector.delta);
+    rig.pattern = window->pattern();
+    rig.projector = std::move(window);
+}
+
+}  // namespace
+
+OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera,
+                  const ProjectorConfig& projector) {
     OpenedRig rig;
     switch (spec.kind) {
         case io::RigSpec::Kind::Replay:
@@ -23,9 +37,11 @@ OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& 
         }
         case io::RigSpec::Kind::Aravis:
             rig.source = std::make_unique<io::AravisSource>("--rig " + spec.toString(), spec.target, camera);
+            openCameraProjector(projector, rig);
             return rig;
         case io::RigSpec::Kind::V4l2:
             rig.source = std::make_unique<io::V4l2Source>("--rig " + spec.toString(), spec.target, camera);
+            openCameraProjector(projector, rig);
             return rig;
     }
     throw io::InputError("--rig " + spec.toString(), "", "unknown rig kind");

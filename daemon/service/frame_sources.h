@@ -6,6 +6,7 @@
 #include "io/frame_source.h"
 #include "io/projector_output.h"
 #include "io/rig_spec.h"
+#include "service/config.h"
 
 namespace everytouch::service {
 
@@ -14,9 +15,12 @@ namespace everytouch::service {
 struct OpenedRig {
     std::unique_ptr<io::FrameSource> source;
     std::unique_ptr<io::ProjectorOutput> projector;  // none for a recording, which shows what it shows
+    cv::Mat pattern;  // the code the projector output embeds, when the daemon draws it (a camera's window)
 };
 
-// Opens the rig a --rig spec names; a camera gets `camera`. Throws InputError when the spec cannot be served.
-OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera);
+// Opens the rig a --rig spec names; a camera gets `camera`, and the projector window when `projector` asks
+// for it (the simulated rig has its own projector). Throws InputError when the spec cannot be served.
+OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera,
+                  const ProjectorConfig& projector);
 
 }  // namespace everytouch::service

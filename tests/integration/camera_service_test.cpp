@@ -12,15 +12,20 @@
 #include <optional>
 #include <thread>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/embedding.h"
 #include "core/pattern.h"
+#include "core/projector_chessboard.h"
 #include "io/calibration_file.h"
+#include "service/table_set_up_step.h"
 #include "sim/rig_geometry.h"
 #include "sim/simulator.h"
 #include "support/bus_commands.h"
@@ -29,6 +34,7 @@
 #include "support/private_bus.h"
 #include "support/process.h"
 #include "support/temp_dir.h"
+#include "support/virtual_display.h"
 
 namespace everytouch {
 namespace {
@@ -189,7 +195,7 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
     EXPECT_THAT(get("StateReason"),
-                HasSubstr("the projected code is not known: set [Projector] Output=external"));
+                HasSubstr("the projected code is not known: set [Projector] Output=window"));
     EXPECT_FALSE(std::filesystem::exists(dir_ / "pattern.png"));
     daemon_->signal(SIGTERM);
     ASSERT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
@@ -319,6 +325,71 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
     EXPECT_EQ(again->index, touchDown->index);
     EXPECT_NEAR(again->x, touchDown->x, 1.0);
     EXPECT_NEAR(again->y, touchDown->y, 1.0);
+}
+
+// Whether the screen shows `content` with the code of `bits` added or taken away within `timeout`.
+bool showsWithTheCode(const test::VirtualDisplay& display, const cv::Mat& content, const cv::Mat& bits,
+                      int delta, std::chrono::seconds timeout) {
+    cv::Mat positive, negative;
+    core::embedCode(content, bits, delta, positive, negative);
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+        const cv::Mat screen = display.grab();
+        if (cv::norm(screen, positive, cv::NORM_INF) <= 1.0 ||
+            cv::norm(screen, negative, cv::NORM_INF) <= 1.0)
+            return true;
+        std::this_thread::sleep_for(5ms);
+    }
+    return false;
+}
+
+TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessboard) {
+    sim::SimParameters rig;
+    rig.cameraSize = cv::Size(320, 240);
+    const core::Calibration calibration = sim::rigCalibration(rig);
+    io::writeCalibrationFile(dir_ / "calibration.yml", calibration);
+    const test::VirtualDisplay display(rig.projectorSize);
+    ::setenv("DISPLAY", display.name().c_str(), 1);
+    ::unsetenv("WAYLAND_DISPLAY");
+
+    startDaemon("PixelFormat=Mono8\nFrameRate=30\n", "[Projector]\nOutput=window\nSeed=5\nDelta=12\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_THAT(daemon_->output(), HasSubstr("calibration images on the window on x11 display 0 \"screen\""));
+    // Between calibrations: the display, white through the calibration's keystone, carrying the code.
+    core::PatternOptions pattern;
+    pattern.size = rig.projectorSize;
+    pattern.seed = 5;
+    const cv::Mat bits = core::generatePattern(pattern);
+    cv::Mat keystone;
+    cv::eigen2cv(calibration.displayToProjector, keystone);
+    cv::Mat idle;
+    cv::warpPerspective(cv::Mat(calibration.displaySize, CV_8UC3, cv::Scalar::all(255)), idle, keystone,
+                        rig.projectorSize);
+    EXPECT_TRUE(showsWithTheCode(display, idle, bits, 12, 20s)) << "the window does not show the display";
+
+    // The projector step shows its chessboard until it gives up (the camera films a ramp), then the display.
+    const test::ProcessResult calibrate =
+        test::runProcess(test::call("Calibrate", {"sa{sv}", "projector", "1", "view_timeout_s", "d", "3"}));
+    ASSERT_EQ(calibrate.exitCode, 0) << calibrate.err;
+    cv::Mat board;
+    core::renderProjectorChessboard(service::tableSetUpChessboard(), rig.projectorSize, board);
+    cv::cvtColor(board, board, cv::COLOR_GRAY2BGR);
+    EXPECT_TRUE(showsWithTheCode(display, board, bits, 12, 20s)) << "the window does not show the chessboard";
+    EXPECT_TRUE(waitForLog("calibration failed")) << "the calibration did not give up";
+    EXPECT_TRUE(showsWithTheCode(display, idle, bits, 12, 20s))
+        << "the window does not show the display again";
+
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+}
+
+TEST_F(CameraServiceTest, AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration) {
+    const test::VirtualDisplay display(cv::Size(320, 240));
+    ::setenv("DISPLAY", display.name().c_str(), 1);
+    startDaemon("PixelFormat=Mono8\n", "[Projector]\nOutput=window\nDisplay=HDMI-9\n");
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 2);
+    EXPECT_THAT(daemon_->output(), HasSubstr("[Projector] Display=: HDMI-9: no such display on x11; it has 0 "
+                                             "\"screen\" (320x240)"));
 }
 
 TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {

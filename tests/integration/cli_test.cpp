@@ -24,8 +24,8 @@ using ::testing::HasSubstr;
 TEST(Everytouchd, HelpListsEveryOption) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--help"});
     EXPECT_EQ(result.exitCode, 0);
-    for (const char* option : {"--config", "--rig", "--log", "--output", "--record", "--frames", "--fast",
-                               "--verbose", "--version"})
+    for (const char* option : {"--config", "--rig", "--log", "--output", "--projector", "--record",
+                               "--frames", "--fast", "--verbose", "--version"})
         EXPECT_THAT(result.out, HasSubstr(option));
 }
 
@@ -220,6 +220,14 @@ TEST(Everytouchd, UnknownOutputIsAUsageErrorNamingTheOption) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--output", "uinput,screen"});
     EXPECT_EQ(result.exitCode, 2);
     EXPECT_THAT(result.err, HasSubstr("--output screen"));
+}
+
+TEST(Everytouchd, UnknownProjectorOutputIsAUsageErrorNamingTheOption) {
+    for (const char* projector : {"beamer", "external:HDMI-1", "overlay"}) {
+        const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--projector", projector});
+        EXPECT_EQ(result.exitCode, 2) << projector;
+        EXPECT_THAT(result.err, HasSubstr("--projector: ")) << projector;
+    }
 }
 
 TEST(Everytouchd, VirtualTouchscreenWithoutUinputFailsNamingIt) {

@@ -53,8 +53,12 @@ TEST(Config, ReadsEveryKey) {
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
-    EXPECT_EQ(config.projector,
-              (ProjectorConfig{ProjectorOutput::External, std::numeric_limits<std::uint64_t>::max(), 12}));
+    EXPECT_EQ(config.projector, (ProjectorConfig{ProjectorOutput::External,
+                                                 std::numeric_limits<std::uint64_t>::max(), 12, ""}));
+
+    write(dir / "everytouchd.conf", "[Projector]\nOutput=window\nDisplay=HDMI-1\n");
+    EXPECT_EQ(loadConfig(dir / "everytouchd.conf", true).projector,
+              (ProjectorConfig{ProjectorOutput::Window, 1, 10, "HDMI-1"}));
 }
 
 TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
@@ -114,9 +118,10 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
          ":2: [Camera] Region: must be at least 64 pixels wide and high, found 32x480"},
         {"[Camera]\nTrigger=Line 0\n",
          ":2: [Camera] Trigger: expected off or a trigger source such as Line0"},
-        {"[Projector]\nOutput=dlp\n", ":2: [Projector] Output: expected none or external, found \"dlp\""},
-        {"[Projector]\nOutput=window\n",
-         ":2: [Projector] Output: window is not part of this build yet; it knows none and external"},
+        {"[Projector]\nOutput=dlp\n",
+         ":2: [Projector] Output: expected none, external or window, found \"dlp\""},
+        {"[Projector]\nOutput=overlay\n",
+         ":2: [Projector] Output: overlay is not part of this build yet; it knows none, external and window"},
         {"[Projector]\nSeed=-1\n", ":2: [Projector] Seed: expected a whole number from 0 to"},
         {"[Projector]\nSeed=18446744073709551616\n", ":2: [Projector] Seed: expected a whole number"},
         {"[Projector]\nDelta=0\n",
