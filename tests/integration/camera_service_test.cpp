@@ -29,6 +29,7 @@
 #include "sim/rig_geometry.h"
 #include "sim/simulator.h"
 #include "support/bus_commands.h"
+#include "support/calibration_distance.h"
 #include "support/fake_gige_camera.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
@@ -381,6 +382,73 @@ TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessb
 
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+}
+
+// The content the window shows now (O, compressed to [delta, 255 - delta]): the mean of two screens of
+// opposite polarity, grabbed as soon as the window has presented the other one.
+cv::Mat windowContent(const test::VirtualDisplay& display) {
+    const cv::Mat first = display.grab();
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        const cv::Mat second = display.grab();
+        if (cv::norm(first, second, cv::NORM_INF) > 0.0) {
+            cv::Mat content;
+            cv::addWeighted(first, 0.5, second, 0.5, 0.0, content);
+            return content;
+        }
+        std::this_thread::sleep_for(1ms);
+    }
+    return first;
+}
+
+// The whole loop of a camera rig: everytouchd shows the table step's chessboard in its projector window (an
+// Xvfb of the test's own); the simulated rig projects what the window shows onto its table, where the card
+// lies, and its camera films it as a GigE Vision camera; the daemon finds the table's pose from those frames.
+// The simulated projector embeds the code anew (of the same seed) into what it takes from the screen.
+TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
+    sim::SimParameters rig;
+    rig.scenario = "table-setup";
+    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
+    const core::Calibration truth = simulator->calibration();
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
+    ::setenv("DISPLAY", display->name().c_str(), 1);
+    ::unsetenv("WAYLAND_DISPLAY");
+
+    camera_.reset();
+    camera_ = std::make_unique<test::FakeGigeCamera>(
+        rig.cameraSize, [simulator, display](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+            simulator->projectImage(windowContent(*display));
+            core::Frame frame;
+            sim::FrameTruth truth;
+            simulator->render(frameId, frame, truth);
+            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
+        });
+    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
+                "[Projector]\nOutput=window\nSeed=" + std::to_string(rig.seed) +
+                    "\nDelta=" + std::to_string(rig.delta) + "\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+
+    const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    double rmsPx = 99;
+    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
+        << tool.out;
+    EXPECT_LE(rmsPx, 0.5);
+    const double worstPx =
+        test::worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    RecordProperty("rms_px", std::to_string(rmsPx));
+    RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    EXPECT_LT(worstPx, 0.5);
+    EXPECT_GT(test::worstCameraToProjectorPx(moved, truth), 2.0)
+        << "the stored calibration should have been off";
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    camera_.reset();
 }
 
 TEST_F(CameraServiceTest, AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration) {

@@ -40,6 +40,7 @@
 #include "sim/rig_geometry.h"
 #include "sim/sim_parameters.h"
 #include "support/bus_commands.h"
+#include "support/calibration_distance.h"
 #include "support/coded_recording.h"
 #include "support/file_contents.h"
 #include "support/notify_socket.h"
@@ -446,23 +447,6 @@ core::Calibration simulatedRig(const std::string& scenario) {
     return sim::rigCalibration(parameters);
 }
 
-// Worst distance between the camera pixel -> projector pixel maps of two calibrations on the table, over the
-// camera pixels the projector lights.
-double worstCameraToProjectorPx(const core::Calibration& found, const core::Calibration& truth) {
-    double worstPx = 0;
-    for (double x = 40; x <= 600; x += 40)
-        for (double y = 40; y <= 440; y += 40) {
-            const Eigen::Vector2d camera = core::applyHomography(truth.projectorToCameraHomography(), {x, y});
-            if (camera.x() < 0 || camera.y() < 0 || camera.x() > truth.cameraSize.width - 1 ||
-                camera.y() > truth.cameraSize.height - 1)
-                continue;
-            worstPx = std::max(worstPx, (core::applyHomography(found.cameraToProjectorHomography(), camera) -
-                                         Eigen::Vector2d(x, y))
-                                            .norm());
-        }
-    return worstPx;
-}
-
 // After a calibration the projector shows the content again: no chessboard in what the camera sees.
 // Frames the camera took before the release may still be on their way through the queue, so the chessboard
 // must be gone within a few snapshots, not necessarily from the first.
@@ -500,14 +484,16 @@ TEST_F(ServiceTest, TableCalibrationOnTheSimulatedRigRecoversItsTruthAndGivesThe
     ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
         << tool.out;
     EXPECT_LE(rmsPx, 0.5);
-    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    const double worstPx =
+        test::worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
     RecordProperty("rms_px", std::to_string(rmsPx));
     RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
     RecordProperty("stored_worst_camera_to_projector_px",
-                   std::to_string(worstCameraToProjectorPx(moved, truth)));
+                   std::to_string(test::worstCameraToProjectorPx(moved, truth)));
     RecordProperty("seconds", std::to_string(seconds));
     EXPECT_LT(worstPx, 0.5);
-    EXPECT_GT(worstCameraToProjectorPx(moved, truth), 2.0) << "the stored calibration should have been off";
+    EXPECT_GT(test::worstCameraToProjectorPx(moved, truth), 2.0)
+        << "the stored calibration should have been off";
     expectProjectorGivenBack(dir_.path(), truth);
 }
 
@@ -528,7 +514,8 @@ TEST_F(ServiceTest, ProjectorCalibrationOnTheSimulatedRigRecoversItsPairAndTable
         << tool.out;
     EXPECT_LE(rmsPx, 0.5);
     const core::Calibration truth = simulatedRig("pair-calibration");
-    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
+    const double worstPx =
+        test::worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
     RecordProperty("rms_px", std::to_string(rmsPx));
     RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
     RecordProperty("seconds", std::to_string(seconds));
@@ -590,7 +577,7 @@ TEST_F(ServiceTest, ANewUserCalibratesFullyThenTheTableThenTapsWhereTheDisplaySh
 
     const core::Calibration calibrated = io::readCalibrationFile(dir_ / "calibration.yml");
     const core::Calibration truth = simulatedRig("pair-calibration");
-    const double worstMapPx = worstCameraToProjectorPx(calibrated, truth);
+    const double worstMapPx = test::worstCameraToProjectorPx(calibrated, truth);
     EXPECT_LT(worstMapPx, 0.5);
     // Computed: the outline as drawn against the display as lit, 33 points per edge.
     double worstComputedPx = 0;
