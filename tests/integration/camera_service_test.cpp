@@ -29,7 +29,7 @@
 #include "sim/rig_geometry.h"
 #include "sim/simulator.h"
 #include "support/bus_commands.h"
-#include "support/calibration_distance.h"
+#include "support/calibration_checks.h"
 #include "support/fake_gige_camera.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
@@ -409,11 +409,7 @@ TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
     rig.scenario = "table-setup";
     auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
     const core::Calibration truth = simulator->calibration();
-    core::Calibration moved = truth;
-    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
-                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
-    moved.tableToCamera = truth.tableToCamera * shift;
-    moved.tableToProjector = truth.tableToProjector * shift;
+    const core::Calibration moved = test::withTheTableMoved(truth);
     io::writeCalibrationFile(dir_ / "calibration.yml", moved);
     auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
     ::setenv("DISPLAY", display->name().c_str(), 1);
@@ -435,9 +431,9 @@ TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
 
     const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
     ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
-    double rmsPx = 99;
-    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
-        << tool.out;
+    const std::optional<double> reported = test::reportedRmsPx(tool.out);
+    ASSERT_TRUE(reported) << tool.out;
+    const double rmsPx = *reported;
     EXPECT_LE(rmsPx, 0.5);
     const double worstPx =
         test::worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);

@@ -40,7 +40,7 @@
 #include "sim/rig_geometry.h"
 #include "sim/sim_parameters.h"
 #include "support/bus_commands.h"
-#include "support/calibration_distance.h"
+#include "support/calibration_checks.h"
 #include "support/coded_recording.h"
 #include "support/file_contents.h"
 #include "support/notify_socket.h"
@@ -395,11 +395,7 @@ TEST_F(ServiceTest, ATableRecordingCalibratesWithoutAProjectorOutputAndSaves) {
     // The rig was moved since the stored calibration: the table is now 15 mm further away and tilted 2
     // degrees under the unchanged projector-camera pair.
     const core::Calibration truth = test::distortedPaperLikeCalibration();
-    core::Calibration moved = truth;
-    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
-                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
-    moved.tableToCamera = truth.tableToCamera * shift;
-    moved.tableToProjector = truth.tableToProjector * shift;
+    const core::Calibration moved = test::withTheTableMoved(truth);
     io::writeCalibrationFile(dir_ / "calibration.yml", moved);
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
     startDaemon({}, {}, CalibrationSceneRecording::path());
@@ -407,9 +403,9 @@ TEST_F(ServiceTest, ATableRecordingCalibratesWithoutAProjectorOutputAndSaves) {
     const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
     ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
     EXPECT_THAT(tool.err, HasSubstr("100% table: Done with the table set-up"));
-    double rmsPx = 99;
-    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
-        << tool.out;
+    const std::optional<double> reported = test::reportedRmsPx(tool.out);
+    ASSERT_TRUE(reported) << tool.out;
+    const double rmsPx = *reported;
     EXPECT_LE(rmsPx, 0.5);
     EXPECT_THAT(tool.out, HasSubstr("Saved"));
     EXPECT_EQ(get("State"), "s \"running\"\n");
@@ -467,11 +463,7 @@ void expectProjectorGivenBack(const std::filesystem::path& dir, const core::Cali
 TEST_F(ServiceTest, TableCalibrationOnTheSimulatedRigRecoversItsTruthAndGivesTheProjectorBack) {
     // The table moved since the stored calibration; the projector-camera pair did not.
     const core::Calibration truth = simulatedRig("table-setup");
-    core::Calibration moved = truth;
-    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
-                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
-    moved.tableToCamera = truth.tableToCamera * shift;
-    moved.tableToProjector = truth.tableToProjector * shift;
+    const core::Calibration moved = test::withTheTableMoved(truth);
     io::writeCalibrationFile(dir_ / "calibration.yml", moved);
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
     startDaemonOn("sim:table-setup", {"--fast"});
@@ -480,9 +472,9 @@ TEST_F(ServiceTest, TableCalibrationOnTheSimulatedRigRecoversItsTruthAndGivesThe
     const test::ProcessResult tool = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
-    double rmsPx = 99;
-    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
-        << tool.out;
+    const std::optional<double> reported = test::reportedRmsPx(tool.out);
+    ASSERT_TRUE(reported) << tool.out;
+    const double rmsPx = *reported;
     EXPECT_LE(rmsPx, 0.5);
     const double worstPx =
         test::worstCameraToProjectorPx(io::readCalibrationFile(dir_ / "calibration.yml"), truth);
@@ -509,9 +501,9 @@ TEST_F(ServiceTest, ProjectorCalibrationOnTheSimulatedRigRecoversItsPairAndTable
     ASSERT_EQ(tool.exitCode, 0) << tool.out << tool.err;
     EXPECT_THAT(tool.err, HasSubstr("Pose 1 of 4 taken. Pose 2 of 4: tilt the board another way"));
     EXPECT_THAT(tool.err, HasSubstr("Pose 4 of 4 taken. Estimating the projector-camera pair from 4 poses"));
-    double rmsPx = 99;
-    ASSERT_EQ(std::sscanf(tool.out.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx), 1)
-        << tool.out;
+    const std::optional<double> reported = test::reportedRmsPx(tool.out);
+    ASSERT_TRUE(reported) << tool.out;
+    const double rmsPx = *reported;
     EXPECT_LE(rmsPx, 0.5);
     const core::Calibration truth = simulatedRig("pair-calibration");
     const double worstPx =

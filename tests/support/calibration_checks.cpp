@@ -1,6 +1,10 @@
-#include "support/calibration_distance.h"
+#include "support/calibration_checks.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Geometry>
 
 #include "core/geometry.h"
 
@@ -19,6 +23,22 @@ double worstCameraToProjectorPx(const core::Calibration& found, const core::Cali
                                             .norm());
         }
     return worstPx;
+}
+
+core::Calibration withTheTableMoved(const core::Calibration& truth) {
+    core::Calibration moved = truth;
+    const Eigen::Isometry3d shift(Eigen::Translation3d(12, -5, -40) *
+                                  Eigen::AngleAxisd(5 * M_PI / 180, Eigen::Vector3d::UnitX()));
+    moved.tableToCamera = truth.tableToCamera * shift;
+    moved.tableToProjector = truth.tableToProjector * shift;
+    return moved;
+}
+
+std::optional<double> reportedRmsPx(const std::string& toolOutput) {
+    double rmsPx = 0;
+    if (std::sscanf(toolOutput.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx) != 1)
+        return std::nullopt;
+    return rmsPx;
 }
 
 }  // namespace everytouch::test
