@@ -139,7 +139,10 @@ fuzz)
         # tests/fuzz/corpus/TARGET are read, never written.
         mkdir -p "build-fuzz/corpus/$target" "build-fuzz/findings/$target"
         echo "fuzzing $target for $seconds s"
-        "build-fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 \
+        # The file readers write every input to a scratch file first: in memory (/dev/shm) they run three
+        # to four times as many inputs a second as on a disk's /tmp.
+        TMPDIR=$( [ -d /dev/shm ] && [ -w /dev/shm ] && echo /dev/shm || echo "${TMPDIR:-/tmp}" ) \
+            "build-fuzz/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=1 -rss_limit_mb=2048 \
             -print_final_stats=1 -artifact_prefix="build-fuzz/findings/$target/" \
             "build-fuzz/corpus/$target" "tests/fuzz/corpus/$target"
     done
