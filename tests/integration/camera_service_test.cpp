@@ -356,6 +356,11 @@ TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessb
     startDaemon("PixelFormat=Mono8\nFrameRate=30\n", "[Projector]\nOutput=window\nSeed=5\nDelta=12\n");
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration images on the window on x11 display 0 \"screen\""));
+    // systemd waits while the window's code is generated, which takes a minute on a large panel.
+    bool extended = false;
+    for (const std::string& message : notify_->messages())
+        extended = extended || message.find("EXTEND_TIMEOUT_USEC=") != std::string::npos;
+    EXPECT_TRUE(extended) << "systemd's start timeout is not extended for the window's code";
     // Between calibrations: the display, white through the calibration's keystone, carrying the code.
     core::PatternOptions pattern;
     pattern.size = rig.projectorSize;
