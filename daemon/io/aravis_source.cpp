@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "io/input_error.h"
+#include "io/thread_name.h"
 
 namespace everytouch::io {
 
@@ -200,6 +201,7 @@ void AravisSource::releaseLostCamera() {
     // Aravis waits for its protocol's timeouts while it lets go of a camera that no longer answers (some
     // 10 s for a GigE camera): on a thread of their own, so that the camera can be tried again meanwhile.
     releaser_ = std::thread([camera = std::move(camera_), stream = std::move(stream_)]() mutable {
+        nameThisThread("et-cam-release");
         stream.reset();
         camera.reset();
     });

@@ -18,6 +18,7 @@
 #include "io/input_error.h"
 #include "io/log.h"
 #include "io/sdl_handles.h"
+#include "io/thread_name.h"
 
 namespace everytouch::io {
 
@@ -106,7 +107,10 @@ WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed,
         throw InputError("[Projector] Delta=", std::to_string(delta), "expected 1 to 127 levels");
     std::promise<Opened> opened;
     std::future<Opened> result = opened.get_future();
-    thread_ = std::thread([this, display, &opened] { run(display, opened); });
+    thread_ = std::thread([this, display, &opened] {
+        nameThisThread("et-projector");
+        run(display, opened);
+    });
     try {
         Opened window = result.get();
         size_ = window.size;

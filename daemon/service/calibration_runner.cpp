@@ -6,6 +6,8 @@
 #include <memory>
 #include <mutex>
 
+#include "io/thread_name.h"
+
 namespace everytouch::service {
 
 namespace {
@@ -27,7 +29,10 @@ CalibrationRunner::CalibrationRunner(FrameTap& tap, io::ProjectorOutput* project
       job_(std::move(job)),
       progress_(std::move(progress)),
       finished_(std::move(finished)),
-      thread_([this] { run(); }) {}
+      thread_([this] {
+          io::nameThisThread("et-calibration");
+          run();
+      }) {}
 
 CalibrationRunner::~CalibrationRunner() {
     cancelled_ = true;

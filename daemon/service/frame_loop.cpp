@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "io/log.h"
+#include "io/thread_name.h"
 
 namespace everytouch::service {
 
@@ -60,8 +61,14 @@ void FrameLoop::start() {
         started_ = Clock::now();
     }
     heartbeatNs_ = Clock::now().time_since_epoch().count();
-    pipelineThread_ = std::thread([this] { runPipeline(); });
-    camera_ = std::thread([this] { runCamera(); });
+    pipelineThread_ = std::thread([this] {
+        io::nameThisThread("et-pipeline");
+        runPipeline();
+    });
+    camera_ = std::thread([this] {
+        io::nameThisThread("et-camera");
+        runCamera();
+    });
 }
 
 void FrameLoop::stop() {

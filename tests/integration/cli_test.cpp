@@ -1,10 +1,13 @@
 // Runs the real everytouchd and everytouch-calib binaries.
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -220,6 +223,32 @@ TEST(Everytouchd, UnknownOutputIsAUsageErrorNamingTheOption) {
     const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--output", "uinput,screen"});
     EXPECT_EQ(result.exitCode, 2);
     EXPECT_THAT(result.err, HasSubstr("--output screen"));
+}
+
+// top -H and ps -L tell the camera's thread from the pipeline's.
+TEST(Everytouchd, NamesItsThreads) {
+    test::TempDir dir;
+    test::BackgroundProcess daemon(
+        {EVERYTOUCHD_PATH, "--rig", "sim:demo", "--log", (dir / "touch.log").string()},
+        dir / "everytouchd.log");
+    ASSERT_TRUE(daemon.waitForOutput("everytouchd", std::chrono::seconds(60))) << daemon.output();
+    const auto named = [](const std::vector<std::string>& names, const std::string& name) {
+        return std::find(names.begin(), names.end(), name) != names.end();
+    };
+    std::vector<std::string> names;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!(named(names, "et-camera") && named(names, "et-pipeline")) &&
+           std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        names.clear();
+        for (const auto& task :
+             std::filesystem::directory_iterator("/proc/" + std::to_string(daemon.pid()) + "/task")) {
+            std::string name;
+            std::getline(std::ifstream(task.path() / "comm"), name);
+            names.push_back(name);
+        }
+    }
+    EXPECT_THAT(names, ::testing::IsSupersetOf({"everytouchd", "et-camera", "et-pipeline"}));
 }
 
 TEST(Everytouchd, UnknownProjectorOutputIsAUsageErrorNamingTheOption) {
