@@ -100,6 +100,9 @@ int Daemon::run() {
                   "EXTEND_TIMEOUT_USEC=300000000\nSTATUS=Opening the projector window and generating its "
                   "code pattern (up to a minute or two on a large panel)");
     }
+    if (!cameraRig_ && config_.projector.output != ProjectorOutput::None)
+        ET_LOG(Notice) << "[Projector] applies to camera rigs; " << spec.toString()
+                       << " brings its own projector and code";
     OpenedRig opened = openRig(spec, options_.fast, config_.camera, config_.projector);
     source_ = std::move(opened.source);
     projector_ = std::move(opened.projector);
