@@ -69,6 +69,7 @@ int status() {
         {bus::kPropertyState, "State"},
         {bus::kPropertyStateReason, "Why"},
         {bus::kPropertyRig, "Rig"},
+        {bus::kPropertyProjector, "Projector"},
         {bus::kPropertyCalibrated, "Calibrated"},
         {bus::kPropertyTouchHeightMm, "Touch height"},
         {bus::kPropertyFrameRate, "Frame rate"},

@@ -25,6 +25,7 @@ inline constexpr const char* kPropertyApiVersion = "APIVersion";
 inline constexpr const char* kPropertyState = "State";
 inline constexpr const char* kPropertyStateReason = "StateReason";
 inline constexpr const char* kPropertyRig = "Rig";
+inline constexpr const char* kPropertyProjector = "Projector";
 inline constexpr const char* kPropertyCalibrated = "Calibrated";
 inline constexpr const char* kPropertyDisplaySize = "DisplaySize";
 inline constexpr const char* kPropertyDisplaySizeMm = "DisplaySizeMm";

@@ -57,6 +57,11 @@ int getRig(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply
     return sd_bus_message_append(reply, "s", serviceOf(userdata).daemon().rig().c_str());
 }
 
+int getProjector(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
+                 sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "s", serviceOf(userdata).daemon().projector().c_str());
+}
+
 int getCalibrated(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
                   sd_bus_error*) noexcept {
     return sd_bus_message_append(reply, "b", static_cast<int>(serviceOf(userdata).daemon().calibrated()));
@@ -177,6 +182,7 @@ const sd_bus_vtable kVtable[] = {
     SD_BUS_PROPERTY(bus::kPropertyState, "s", getState, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     SD_BUS_PROPERTY(bus::kPropertyStateReason, "s", getStateReason, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     SD_BUS_PROPERTY(bus::kPropertyRig, "s", getRig, 0, SD_BUS_VTABLE_PROPERTY_CONST),
+    SD_BUS_PROPERTY(bus::kPropertyProjector, "s", getProjector, 0, SD_BUS_VTABLE_PROPERTY_CONST),
     SD_BUS_PROPERTY(bus::kPropertyCalibrated, "b", getCalibrated, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),
     // Statistics change with every frame: clients poll them instead of being flooded with signals.
     SD_BUS_PROPERTY(bus::kPropertyDisplaySize, "(uu)", getDisplaySize, 0, 0),

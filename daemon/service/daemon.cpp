@@ -108,6 +108,7 @@ int Daemon::run() {
     projector_ = std::move(opened.projector);
     pattern_ = std::move(opened.pattern);
     recordedRig_ = spec.kind == io::RigSpec::Kind::Replay;
+    projectorName_ = describeProjector();
     ET_LOG(Info) << "everytouchd " << kVersion << " on " << source_->describe()
                  << (projector_ ? ", calibration images on " + projector_->describe() : std::string());
     const std::optional<io::RigDescription> rig = source_->rig();
@@ -180,6 +181,17 @@ void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
         drawDisplayThrough(*store_->active());
         adoptExternalCode(*store_->active());
     }
+}
+
+std::string Daemon::describeProjector() const {
+    if (projector_)
+        return projector_->describe();
+    if (recordedRig_)
+        return "none: a recording shows what it shows";
+    if (config_.projector.output == ProjectorOutput::External)
+        return "a projector that embeds the code of seed " + std::to_string(config_.projector.seed) +
+               " itself, " + std::to_string(config_.projector.delta) + " levels";
+    return "none: the code and the calibration images have nowhere to go ([Projector] Output=)";
 }
 
 std::optional<io::RigDescription> Daemon::recordedRig() const {

@@ -69,6 +69,8 @@ public:
     // Why the state is degraded or failed, in words; empty otherwise.
     std::string stateReason() const;
     const std::string& rig() const { return rigName_; }
+    // Where the code and the calibration images come from, in words.
+    const std::string& projector() const { return projectorName_; }
     // The active calibration, where the display's size and its size on the table come from; none when not
     // calibrated.
     const std::optional<core::Calibration>& activeCalibration() const;
@@ -98,6 +100,7 @@ private:
     // What a recording says of the rig: its own description, or a camera rig's calibration, code and frame
     // rate once all are known.
     std::optional<io::RigDescription> recordedRig() const;
+    std::string describeProjector() const;
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
     void startFrameLoop(std::vector<io::TouchSink*> sinks);
@@ -123,6 +126,7 @@ private:
     DaemonOptions options_;
     DaemonConfig config_;
     std::string rigName_;
+    std::string projectorName_;
     bool cameraRig_ = false;
     std::string devicePath_;  // the virtual touchscreen's event node; empty without one
     double touchHeightMm_ = 0.0;

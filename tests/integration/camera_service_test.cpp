@@ -203,6 +203,7 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
 
     startDaemon("PixelFormat=Mono8\nFrameRate=30\n", "[Projector]\nOutput=external\nSeed=7\n");
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_EQ(get("Projector"), "s \"a projector that embeds the code of seed 7 itself, 10 levels\"\n");
     // Detection runs on the camera's pairs: the ramp it films shows no hand, and no code either, which
     // is not a fault.
     std::string state;
@@ -356,6 +357,7 @@ TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessb
     startDaemon("PixelFormat=Mono8\nFrameRate=30\n", "[Projector]\nOutput=window\nSeed=5\nDelta=12\n");
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration images on the window on x11 display 0 \"screen\""));
+    EXPECT_THAT(get("Projector"), HasSubstr("the window on x11 display 0 \\\"screen\\\" (640x480) at 60 Hz"));
     // systemd waits while the window's code is generated, which takes a minute on a large panel.
     bool extended = false;
     for (const std::string& message : notify_->messages())

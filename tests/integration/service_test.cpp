@@ -242,6 +242,7 @@ TEST_F(ServiceTest, PropertiesAreReadableByEveryone) {
     const test::ProcessResult status = test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "status"}));
     EXPECT_EQ(status.exitCode, 0) << status.err;
     EXPECT_THAT(status.out, HasSubstr("State:         running"));
+    EXPECT_THAT(status.out, HasSubstr("Projector:     none: a recording shows what it shows"));
     EXPECT_THAT(status.out, Not(HasSubstr("Why:")));  // nothing to explain
     EXPECT_EQ(get("StateReason"), "s \"\"\n");
     EXPECT_THAT(status.out, HasSubstr("Calibrated:    yes"));
