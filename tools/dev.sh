@@ -96,8 +96,8 @@ sanitize)
     # simulated rig's tap through the fake GigE camera renders 84 frames on the camera's thread and the
     # simulated rig's own run 260 more (minutes under ASan): the GigE path runs under the sanitizers in the
     # camera's other tests, and the detection in the pipeline's; so does its calibration of the table through
-    # the projector window. The daemon's projector window: SDL2 unloads at its end the X11 libraries it
-    # loaded, and LeakSanitizer reports what they keep for the process in frames it cannot name, which ends
+    # the projector window. The daemon's projector window: SDL2 unloads at its end the libraries it loaded at
+    # run time, and LeakSanitizer reports what they keep for the process in frames it cannot name, which ends
     # the daemon with its own status; the window runs under the sanitizers in display_tests (there without
     # the leak check, tests/CMakeLists.txt).
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
