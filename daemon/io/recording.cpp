@@ -133,6 +133,10 @@ cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
 
 }  // namespace
 
+cv::Mat readPatternImage(const std::filesystem::path& path, cv::Size size) {
+    return readBinaryImage(path, size, "projector size") / 255;
+}
+
 std::filesystem::path Recording::framePath(const std::filesystem::path& directory, std::uint64_t index) {
     return indexedPath(directory, "frames", index);
 }
@@ -173,8 +177,7 @@ Recording Recording::open(const std::filesystem::path& directory) {
         throw InputError(rigName, "pattern", "missing");
     if (!pattern.isString() || pattern.string().empty())
         throw InputError(rigName, "pattern", "expected a file name");
-    rig.pattern =
-        readBinaryImage(directory / pattern.string(), rig.calibration.projectorSize, "projector size") / 255;
+    rig.pattern = readPatternImage(directory / pattern.string(), rig.calibration.projectorSize);
 
     const std::filesystem::path framesPath = directory / "frames.csv";
     if (!std::filesystem::is_regular_file(framesPath))

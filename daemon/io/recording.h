@@ -63,6 +63,9 @@ private:
 // Writes a code pattern (CV_8UC1, 0 or 1) as a recording's pattern.png holds it, 255 on 1-bits, replacing
 // `path` atomically. Throws std::system_error or InputError naming the path.
 void writePatternImage(const std::filesystem::path& path, const cv::Mat& pattern);
+// Reads a pattern as writePatternImage writes it: an 8-bit PNG of `size` holding only 0 and 255. Returns
+// CV_8UC1, 0 or 1. Throws InputError naming the path for anything else.
+cv::Mat readPatternImage(const std::filesystem::path& path, cv::Size size);
 
 // Writes a recording directory from any rig. The directory must not exist or be empty. With truth, truth.csv
 // takes the fingers of every frame; with masks, masks/ takes the hand mask of every frame.

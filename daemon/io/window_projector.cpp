@@ -17,6 +17,7 @@
 #include "core/pattern.h"
 #include "io/input_error.h"
 #include "io/log.h"
+#include "io/recording.h"
 #include "io/sdl_handles.h"
 #include "io/thread_name.h"
 
@@ -100,9 +101,39 @@ void checkDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displa
         throw std::invalid_argument("display to projector: expected a finite, invertible homography");
 }
 
+// The pattern of `seed` at `size`: as kept in `directory` by an earlier start, else generated and kept there.
+cv::Mat patternOf(std::uint64_t seed, cv::Size size, const std::filesystem::path& directory) {
+    const std::filesystem::path kept =
+        directory.empty()
+            ? std::filesystem::path()
+            : directory / ("pattern-seed" + std::to_string(seed) + "-" + std::to_string(size.width) + "x" +
+                           std::to_string(size.height) + ".png");
+    if (!kept.empty() && std::filesystem::exists(kept)) {
+        try {
+            return readPatternImage(kept, size);
+        } catch (const std::exception& error) {
+            ET_LOG(Warning) << error.what() << "; the code pattern is generated again";
+        }
+    }
+    core::PatternOptions options;
+    options.size = size;
+    options.seed = seed;
+    cv::Mat pattern = core::generatePattern(options);
+    if (!kept.empty()) {
+        try {
+            writePatternImage(kept, pattern);
+        } catch (const std::exception& error) {
+            ET_LOG(Warning) << "the code pattern is not kept for the next start: " << error.what();
+        }
+    }
+    return pattern;
+}
+
 }  // namespace
 
-WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed, int delta) : delta_(delta) {
+WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed, int delta,
+                                 const std::filesystem::path& patternDirectory)
+    : delta_(delta) {
     if (delta < 1 || delta > 127)
         throw InputError("[Projector] Delta=", std::to_string(delta), "expected 1 to 127 levels");
     std::promise<Opened> opened;
@@ -120,10 +151,7 @@ WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed,
         throw;
     }
     try {
-        core::PatternOptions options;
-        options.size = size_;
-        options.seed = seed;
-        pattern_ = core::generatePattern(options);
+        pattern_ = patternOf(seed, size_, patternDirectory);
         embedAndHandOver(idleImage());
     } catch (...) {
         stopping_ = true;

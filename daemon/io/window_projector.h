@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <future>
 #include <mutex>
 #include <string>
@@ -25,8 +26,10 @@ public:
     // name or its monitor's) or its number from 0; empty for the first. The code is the pattern of `seed` at
     // the output's size, `delta` levels strong (1..127). Throws InputError naming [Projector] Display= for a
     // display that does not exist (listing those that do), std::runtime_error when no display server is
-    // reachable or the window cannot be made.
-    WindowProjector(const std::string& display, std::uint64_t seed, int delta);
+    // reachable or the window cannot be made. Generating the pattern takes a minute at 1920x1080: once
+    // generated it is kept in `patternDirectory` (empty: nowhere) and read from there at the next start.
+    WindowProjector(const std::string& display, std::uint64_t seed, int delta,
+                    const std::filesystem::path& patternDirectory);
     ~WindowProjector() override;
     WindowProjector(const WindowProjector&) = delete;
     WindowProjector& operator=(const WindowProjector&) = delete;

@@ -103,7 +103,8 @@ int Daemon::run() {
     if (!cameraRig_ && config_.projector.output != ProjectorOutput::None)
         ET_LOG(Notice) << "[Projector] applies to camera rigs; " << spec.toString()
                        << " brings its own projector and code";
-    OpenedRig opened = openRig(spec, options_.fast, config_.camera, config_.projector);
+    OpenedRig opened =
+        openRig(spec, options_.fast, config_.camera, config_.projector, calibrationPath().parent_path());
     source_ = std::move(opened.source);
     projector_ = std::move(opened.projector);
     pattern_ = std::move(opened.pattern);
@@ -163,10 +164,14 @@ int Daemon::run() {
     return exitStatus_;
 }
 
+std::filesystem::path Daemon::calibrationPath() const {
+    if (config_.calibrationPath.empty() && cameraRig_)
+        return kDefaultCalibrationPath;
+    return config_.calibrationPath;
+}
+
 void Daemon::loadCalibration(const std::optional<io::RigDescription>& rig) {
-    std::filesystem::path storePath = config_.calibrationPath;
-    if (storePath.empty() && cameraRig_)
-        storePath = kDefaultCalibrationPath;
+    const std::filesystem::path storePath = calibrationPath();
     store_.emplace(storePath, rig ? std::optional(rig->calibration) : std::nullopt);
     if (const std::optional<std::string> problem = store_->load())
         ET_LOG(Error) << *problem

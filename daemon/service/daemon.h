@@ -101,6 +101,8 @@ private:
     // rate once all are known.
     std::optional<io::RigDescription> recordedRig() const;
     std::string describeProjector() const;
+    // The calibration file: the configuration's, a camera rig's default, or none (the rig's own).
+    std::filesystem::path calibrationPath() const;
     std::vector<io::TouchSink*> openOutputs();
     int startEventLoop();
     void startFrameLoop(std::vector<io::TouchSink*> sinks);

@@ -12,10 +12,12 @@ namespace everytouch::service {
 
 namespace {
 
-void openCameraProjector(const ProjectorConfig& projector, OpenedRig& rig) {
+void openCameraProjector(const ProjectorConfig& projector, const std::filesystem::path& stateDirectory,
+                         OpenedRig& rig) {
     if (projector.output != ProjectorOutput::Window)
         return;
-    auto window = std::make_unique<io::WindowProjector>(projector.display, projector.seed, projector.delta);
+    auto window = std::make_unique<io::WindowProjector>(projector.display, projector.seed, projector.delta,
+                                                        stateDirectory);
     rig.pattern = window->pattern();
     rig.projector = std::move(window);
 }
@@ -23,7 +25,7 @@ void openCameraProjector(const ProjectorConfig& projector, OpenedRig& rig) {
 }  // namespace
 
 OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera,
-                  const ProjectorConfig& projector) {
+                  const ProjectorConfig& projector, const std::filesystem::path& stateDirectory) {
     OpenedRig rig;
     switch (spec.kind) {
         case io::RigSpec::Kind::Replay:
@@ -37,11 +39,11 @@ OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& 
         }
         case io::RigSpec::Kind::Aravis:
             rig.source = std::make_unique<io::AravisSource>("--rig " + spec.toString(), spec.target, camera);
-            openCameraProjector(projector, rig);
+            openCameraProjector(projector, stateDirectory, rig);
             return rig;
         case io::RigSpec::Kind::V4l2:
             rig.source = std::make_unique<io::V4l2Source>("--rig " + spec.toString(), spec.target, camera);
-            openCameraProjector(projector, rig);
+            openCameraProjector(projector, stateDirectory, rig);
             return rig;
     }
     throw io::InputError("--rig " + spec.toString(), "", "unknown rig kind");

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <filesystem>
 #include <memory>
 
 #include "io/camera_settings.h"
@@ -19,8 +20,9 @@ struct OpenedRig {
 };
 
 // Opens the rig a --rig spec names; a camera gets `camera`, and the projector window when `projector` asks
-// for it (the simulated rig has its own projector). Throws InputError when the spec cannot be served.
+// for it (the simulated rig has its own projector), its code pattern kept in `stateDirectory` between starts.
+// Throws InputError when the spec cannot be served.
 OpenedRig openRig(const io::RigSpec& spec, bool fast, const io::CameraSettings& camera,
-                  const ProjectorConfig& projector);
+                  const ProjectorConfig& projector, const std::filesystem::path& stateDirectory);
 
 }  // namespace everytouch::service

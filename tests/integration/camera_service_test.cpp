@@ -358,6 +358,8 @@ TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessb
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration images on the window on x11 display 0 \"screen\""));
     EXPECT_THAT(get("Projector"), HasSubstr("the window on x11 display 0 \\\"screen\\\" (640x480) at 60 Hz"));
+    EXPECT_TRUE(std::filesystem::exists(dir_ / "pattern-seed5-640x480.png"))
+        << "the window's pattern is not kept beside the calibration for the next start";
     // systemd waits while the window's code is generated, which takes a minute on a large panel.
     bool extended = false;
     for (const std::string& message : notify_->messages())

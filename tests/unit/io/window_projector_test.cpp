@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <thread>
 
@@ -12,8 +13,11 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/embedding.h"
+#include "core/pattern.h"
 #include "core/projector_chessboard.h"
 #include "io/input_error.h"
+#include "io/recording.h"
+#include "support/temp_dir.h"
 #include "support/virtual_display.h"
 
 namespace everytouch::io {
@@ -72,7 +76,7 @@ protected:
 };
 
 TEST_F(WindowProjectorTest, ShowsAnImageWithTheCodeAddedAndTakenAwayOnAlternateRefreshes) {
-    WindowProjector window("", 7, kDelta);
+    WindowProjector window("", 7, kDelta, {});
     ASSERT_EQ(window.size(), kScreen);
     EXPECT_THAT(window.describe(), HasSubstr("x11 display 0"));
     ASSERT_EQ(window.pattern().size(), kScreen);
@@ -110,7 +114,7 @@ TEST_F(WindowProjectorTest, ShowsAnImageWithTheCodeAddedAndTakenAwayOnAlternateR
 }
 
 TEST_F(WindowProjectorTest, BetweenImagesTheDisplayAreaIsWhiteThroughTheKeystoneWithTheCode) {
-    WindowProjector window("screen", 3, kDelta);
+    WindowProjector window("screen", 3, kDelta, {});
     // A display of 600 x 400 drawn at half size, its corner at (50, 40) of the panel.
     Eigen::Matrix3d displayToProjector;
     displayToProjector << 0.5, 0.0, 50.0, 0.0, 0.5, 40.0, 0.0, 0.0, 1.0;
@@ -130,8 +134,39 @@ TEST_F(WindowProjectorTest, BetweenImagesTheDisplayAreaIsWhiteThroughTheKeystone
     EXPECT_EQ(grabbed.others, 0);
 }
 
+// Generating the pattern takes a minute on a large panel: the next start reads it where the first kept it.
+TEST_F(WindowProjectorTest, KeepsItsPatternForTheNextStartAndGeneratesItAgainWhenTheKeptOneIsBad) {
+    test::TempDir state;
+    const std::filesystem::path kept = state.path() / "pattern-seed9-400x300.png";
+    core::PatternOptions options;
+    options.size = kScreen;
+    options.seed = 9;
+    const cv::Mat generated = core::generatePattern(options);
+    {
+        WindowProjector window("", 9, kDelta, state.path());
+        EXPECT_EQ(cv::norm(window.pattern(), generated, cv::NORM_INF), 0.0);
+    }
+    ASSERT_TRUE(std::filesystem::exists(kept));
+    EXPECT_EQ(cv::norm(readPatternImage(kept, kScreen), generated, cv::NORM_INF), 0.0);
+
+    // What is kept is what the next start shows: here another pattern, put in its place.
+    cv::Mat other = 1 - generated;
+    writePatternImage(kept, other);
+    {
+        WindowProjector window("", 9, kDelta, state.path());
+        EXPECT_EQ(cv::norm(window.pattern(), other, cv::NORM_INF), 0.0);
+    }
+    // A kept file that is not a pattern of this size is generated again and replaced.
+    std::ofstream(kept, std::ios::trunc) << "not a png";
+    {
+        WindowProjector window("", 9, kDelta, state.path());
+        EXPECT_EQ(cv::norm(window.pattern(), generated, cv::NORM_INF), 0.0);
+    }
+    EXPECT_EQ(cv::norm(readPatternImage(kept, kScreen), generated, cv::NORM_INF), 0.0);
+}
+
 TEST_F(WindowProjectorTest, RefusesWhatItCannotShow) {
-    WindowProjector window("0", 1, kDelta);
+    WindowProjector window("0", 1, kDelta, {});
     EXPECT_THROW(window.show(cv::Mat(100, 100, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
     EXPECT_THROW(window.show(cv::Mat(kScreen, CV_16UC1, cv::Scalar(0))), std::invalid_argument);
     EXPECT_THROW(window.setDisplayToProjector(cv::Size(640, 480), Eigen::Matrix3d::Zero()),
@@ -142,14 +177,14 @@ TEST_F(WindowProjectorTest, RefusesWhatItCannotShow) {
 
 TEST_F(WindowProjectorTest, AnUnknownDisplayIsRefusedNamingThoseThatExist) {
     try {
-        WindowProjector window("HDMI-9", 1, kDelta);
+        WindowProjector window("HDMI-9", 1, kDelta, {});
         FAIL() << "opened a display that does not exist";
     } catch (const InputError& error) {
         EXPECT_THAT(error.what(), HasSubstr("[Projector] Display=: HDMI-9: no such display"));
         EXPECT_THAT(error.what(), HasSubstr("0 \"screen\" (400x300)"));
     }
-    EXPECT_THROW(WindowProjector("", 1, 0), InputError);
-    EXPECT_THROW(WindowProjector("", 1, 128), InputError);
+    EXPECT_THROW(WindowProjector("", 1, 0, {}), InputError);
+    EXPECT_THROW(WindowProjector("", 1, 128, {}), InputError);
 }
 
 TEST(WindowProjectorWithoutDisplay, SaysThatNoDisplayServerIsReachable) {
@@ -159,7 +194,7 @@ TEST(WindowProjectorWithoutDisplay, SaysThatNoDisplayServerIsReachable) {
     ::unsetenv("WAYLAND_DISPLAY");
     ::unsetenv("SDL_VIDEODRIVER");
     try {
-        WindowProjector window("", 1, kDelta);
+        WindowProjector window("", 1, kDelta, {});
         FAIL() << "opened a window without a display server";
     } catch (const std::runtime_error& error) {
         EXPECT_THAT(error.what(), HasSubstr("no display server is reachable for the projector window"));
