@@ -94,11 +94,11 @@ int Daemon::run() {
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
     if (cameraRig_ && config_.projector.output == ProjectorOutput::Window) {
-        // The window's code pattern is generated at the output's size before the daemon is ready: under a
-        // second at 640x480, about a minute at 1920x1080. systemd's start timeout waits that long.
+        // At the first start on an output the window's code pattern is generated before the daemon is ready:
+        // under a second at 640x480, about a minute at 1920x1080. systemd's start timeout waits that long.
         sd_notify(0,
-                  "EXTEND_TIMEOUT_USEC=300000000\nSTATUS=Opening the projector window and generating its "
-                  "code pattern (up to a minute or two on a large panel)");
+                  "EXTEND_TIMEOUT_USEC=300000000\nSTATUS=Opening the projector window (at the first start on "
+                  "an output its code pattern takes up to a minute or two on a large panel)");
     }
     if (!cameraRig_ && config_.projector.output != ProjectorOutput::None)
         ET_LOG(Notice) << "[Projector] applies to camera rigs; " << spec.toString()
