@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include <Eigen/LU>
@@ -131,6 +132,14 @@ Result<KeystoneFit> fitDisplayToTable(const Calibration& calibration, cv::Size d
     fit.displayToProjector = tableToProjector * displayToTable;
     fit.displayToProjector /= fit.displayToProjector(2, 2);
     return fit;
+}
+
+void checkDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
+    if (displaySize.width <= 0 || displaySize.height <= 0)
+        throw std::invalid_argument("display size: expected a positive width and height");
+    if (!displayToProjector.allFinite() || std::abs(displayToProjector.determinant()) < 1e-12 ||
+        displayToProjector(2, 2) == 0.0)
+        throw std::invalid_argument("display to projector: expected a finite, invertible homography");
 }
 
 }  // namespace everytouch::core

@@ -22,4 +22,8 @@ struct KeystoneFit {
 // convex quadrilateral on the table or either size is empty.
 Result<KeystoneFit> fitDisplayToTable(const Calibration& calibration, cv::Size displaySize);
 
+// What a projector output is given to draw the display through: throws std::invalid_argument for an empty
+// display size or a displayToProjector that is not a finite, invertible homography with H(2,2) != 0.
+void checkDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector);
+
 }  // namespace everytouch::core

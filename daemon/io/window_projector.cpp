@@ -9,11 +9,11 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/LU>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/embedding.h"
+#include "core/keystone.h"
 #include "core/pattern.h"
 #include "io/input_error.h"
 #include "io/log.h"
@@ -93,14 +93,6 @@ int findDisplay(const std::string& display) {
                      std::string("no such display on ") + SDL_GetCurrentVideoDriver() + "; it has " + known);
 }
 
-void checkDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
-    if (displaySize.width <= 0 || displaySize.height <= 0)
-        throw std::invalid_argument("display size: expected a positive width and height");
-    if (!displayToProjector.allFinite() || std::abs(displayToProjector.determinant()) < 1e-12 ||
-        displayToProjector(2, 2) == 0.0)
-        throw std::invalid_argument("display to projector: expected a finite, invertible homography");
-}
-
 // The pattern of `seed` at `size`: as kept in `directory` by an earlier start, else generated and kept there.
 cv::Mat patternOf(std::uint64_t seed, cv::Size size, const std::filesystem::path& directory) {
     const std::filesystem::path kept =
@@ -169,7 +161,7 @@ WindowProjector::~WindowProjector() {
 }
 
 void WindowProjector::setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
-    checkDisplayToProjector(displaySize, displayToProjector);
+    core::checkDisplayToProjector(displaySize, displayToProjector);
     displaySize_ = displaySize;
     displayToProjector_ = displayToProjector / displayToProjector(2, 2);
     if (!showing_)

@@ -42,11 +42,6 @@ public:
 
     // The code every image carries: 0 or 1 per projector pixel (CV_8UC1, size()).
     const cv::Mat& pattern() const { return pattern_; }
-    int delta() const { return delta_; }
-    // Refreshes presented, and refreshes that passed without a new image (each swaps the polarity the camera
-    // sees; the camera's side re-locks on the code's sign).
-    std::uint64_t presentedRefreshes() const { return presented_.load(); }
-    std::uint64_t missedRefreshes() const { return missed_.load(); }
 
 private:
     struct Opened {
@@ -71,6 +66,8 @@ private:
     bool fresh_ = false;
 
     std::atomic<bool> stopping_{false};
+    // Refreshes presented, and refreshes that passed without a new image (each swaps the polarity the camera
+    // sees; the camera's side re-locks on the code's sign): said when the window closes.
     std::atomic<std::uint64_t> presented_{0};
     std::atomic<std::uint64_t> missed_{0};
     std::thread thread_;

@@ -175,16 +175,13 @@ const std::vector<KeySpec>& keySpecs() {
          }},
         {"Projector", "Output",
          [](DaemonConfig& config, const std::string& value) {
-             if (value.empty() || value == "none")
-                 config.projector.output = ProjectorOutput::None;
-             else if (value == "external")
-                 config.projector.output = ProjectorOutput::External;
-             else if (value == "window")
-                 config.projector.output = ProjectorOutput::Window;
-             else if (value == "overlay")
+             if (value == "overlay")
                  throw BadValue{value + " is not part of this build yet; it knows none, external and window"};
-             else
+             const std::optional<ProjectorOutput> output =
+                 value.empty() ? ProjectorOutput::None : parseProjectorOutput(value);
+             if (!output)
                  throw BadValue{"expected none, external or window, found \"" + value + "\""};
+             config.projector.output = *output;
          }},
         {"Projector", "Display",
          [](DaemonConfig& config, const std::string& value) { config.projector.display = value; }},
@@ -315,6 +312,16 @@ std::vector<std::pair<std::string, std::string>> configKeys() {
 
 std::filesystem::path dropInDirectory(const std::filesystem::path& mainFile) {
     return mainFile.string() + ".d";
+}
+
+std::optional<ProjectorOutput> parseProjectorOutput(std::string_view name) {
+    if (name == "none")
+        return ProjectorOutput::None;
+    if (name == "external")
+        return ProjectorOutput::External;
+    if (name == "window")
+        return ProjectorOutput::Window;
+    return std::nullopt;
 }
 
 DaemonConfig loadConfig(const std::filesystem::path& mainFile, bool mustExist) {

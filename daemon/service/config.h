@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -32,6 +33,9 @@ inline constexpr int kMinRegionSide = 64;
 // seed, or the daemon's own fullscreen window on the projector's output, which also shows the calibration
 // images.
 enum class ProjectorOutput { None, External, Window };
+
+// "none", "external" or "window"; nothing for any other name.
+std::optional<ProjectorOutput> parseProjectorOutput(std::string_view name);
 
 struct ProjectorConfig {
     ProjectorOutput output = ProjectorOutput::None;  // [Projector] Output=

@@ -35,15 +35,11 @@ void applyProjectorOption(const std::string& option, ProjectorConfig& projector)
     if (colon != std::string::npos && output != "window")
         throw io::InputError("--projector", "",
                              "only a window takes a display (window:DISPLAY), not \"" + option + "\"");
-    if (output == "none")
-        projector.output = ProjectorOutput::None;
-    else if (output == "external")
-        projector.output = ProjectorOutput::External;
-    else if (output == "window")
-        projector.output = ProjectorOutput::Window;
-    else
+    const std::optional<ProjectorOutput> parsed = parseProjectorOutput(output);
+    if (!parsed)
         throw io::InputError("--projector", "",
                              "expected none, external, window or window:DISPLAY, found \"" + option + "\"");
+    projector.output = *parsed;
     if (colon != std::string::npos)
         projector.display = option.substr(colon + 1);
 }

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/geometry.h"
+#include "core/keystone.h"
 #include "core/pattern.h"
 #include "sim/rig_geometry.h"
 
@@ -97,11 +98,7 @@ SceneState Simulator::sceneAt(double seconds) const {
 }
 
 void Simulator::setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
-    if (displaySize.width <= 0 || displaySize.height <= 0)
-        throw std::invalid_argument("display size: expected a positive width and height");
-    if (!displayToProjector.allFinite() || std::abs(displayToProjector.determinant()) < 1e-12 ||
-        displayToProjector(2, 2) == 0.0)
-        throw std::invalid_argument("display to projector: expected a finite, invertible homography");
+    core::checkDisplayToProjector(displaySize, displayToProjector);
     const Eigen::Matrix3d normalised = displayToProjector / displayToProjector(2, 2);
     if (displaySize == calibration_.displaySize &&
         normalised.isApprox(calibration_.displayToProjector, 1e-12))

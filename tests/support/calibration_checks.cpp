@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
 #include "core/geometry.h"
+#include "io/calibration_file.h"
 
 namespace everytouch::test {
 
@@ -39,6 +41,23 @@ std::optional<double> reportedRmsPx(const std::string& toolOutput) {
     if (std::sscanf(toolOutput.c_str(), "Calibrated: RMS reprojection error %lf px.", &rmsPx) != 1)
         return std::nullopt;
     return rmsPx;
+}
+
+void expectTheTableFound(const ProcessResult& tool, const std::filesystem::path& saved,
+                         const core::Calibration& moved, const core::Calibration& truth) {
+    EXPECT_EQ(tool.exitCode, 0) << tool.out << tool.err;
+    const std::optional<double> rmsPx = reportedRmsPx(tool.out);
+    EXPECT_TRUE(rmsPx) << "no RMS error reported: " << tool.out;
+    if (tool.exitCode != 0 || !rmsPx)
+        return;
+    EXPECT_LE(*rmsPx, 0.5);
+    const double worstPx = worstCameraToProjectorPx(io::readCalibrationFile(saved), truth);
+    const double storedWorstPx = worstCameraToProjectorPx(moved, truth);
+    ::testing::Test::RecordProperty("rms_px", std::to_string(*rmsPx));
+    ::testing::Test::RecordProperty("worst_camera_to_projector_px", std::to_string(worstPx));
+    ::testing::Test::RecordProperty("stored_worst_camera_to_projector_px", std::to_string(storedWorstPx));
+    EXPECT_LT(worstPx, 0.5);
+    EXPECT_GT(storedWorstPx, 2.0) << "the stored calibration should have been off";
 }
 
 }  // namespace everytouch::test
