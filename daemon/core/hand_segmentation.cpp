@@ -153,6 +153,12 @@ private:
 // Without a view beyond the projection the noise is taken as this variance of S (DN^2): a camera at its
 // default gain with some 1.4 DN of noise per frame.
 constexpr float kFallbackNoiseVariance = 4.0f;
+// Windows beyond the projection needed to measure the noise there: the median of their variances then lies
+// within a few per cent of the noise's.
+constexpr std::size_t kMinUnlitBlocks = 32;
+// Where nothing is lit, S of a colour camera is the largest of three channels' noise: its mean is 0.846 and
+// its standard deviation 0.748 of one channel's, so its level is 1.13 standard deviations of S itself.
+constexpr float kZeroLevelPerSd = 1.1314f;
 // How many standard deviations of chance correlation the table's expected correlation must exceed for the
 // code to tell the table from something else.
 constexpr float kSignificance = 3.0f;
@@ -260,6 +266,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     // The per-frame buffers at their largest, so that no frame allocates.
     const std::size_t blockCount = static_cast<std::size_t>(blocks.area());
     values_.reserve(blockCount);
+    unlitVariances_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
     blocksToHand_.resize(blockCount);
@@ -302,7 +309,7 @@ void HandSegmenter::segment(const cv::Mat& texture, const cv::Mat& subtraction, 
 
 void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask) {
     measureCodeEvidence(subtraction, tableCode_, evidence_);
-    classifyBlocks();
+    classifyBlocks(texture.channels());
     keepHandComponents(subtraction);
     mask.create(texture.size(), CV_8UC1);
     fill(mask, 0);
@@ -328,23 +335,30 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
                    radius, majorityScratch_);
 }
 
-void HandSegmenter::classifyBlocks() {
+void HandSegmenter::classifyBlocks(int channels) {
     const CodeEvidence::Window& narrow = evidence_.narrow;
     const int rows = narrow.correlation.rows, cols = narrow.correlation.cols;
     // Where the camera sees beyond the projection S holds nothing but noise: its level (which the largest
-    // of three channels' differences lifts above zero) and its variance.
+    // of three channels' differences lifts above zero) and its variance, over the whole windows that hold no
+    // code pixel, so that the projection's blurred edge stays out. A window that the image's edge cuts short
+    // is no view beyond the projection: a camera framed on the projection has none.
+    const int reach = evidence_.windowBlocks / 2;
     values_.clear();
-    for (int by = 0; by < rows; ++by)
-        for (int bx = 0; bx < cols; ++bx)
-            if (std::isnan(narrow.correlation.at<float>(by, bx)))
+    unlitVariances_.clear();
+    for (int by = reach; by < rows - reach; ++by)
+        for (int bx = reach; bx < cols - reach; ++bx)
+            if (evidence_.beyondProjection(by, bx)) {
                 values_.push_back(narrow.meanS.at<float>(by, bx));
-    const float zeroLevel = quantile(values_, 0.5);
-    values_.clear();
-    for (int by = 0; by < rows; ++by)
-        for (int bx = 0; bx < cols; ++bx)
-            if (std::isnan(narrow.correlation.at<float>(by, bx)))
-                values_.push_back(narrow.varianceS.at<float>(by, bx));
-    noiseVariance_ = values_.empty() ? kFallbackNoiseVariance : std::max(quantile(values_, 0.5), 0.25f);
+                unlitVariances_.push_back(narrow.varianceS.at<float>(by, bx));
+            }
+    float zeroLevel = 0.0f;
+    if (values_.size() >= kMinUnlitBlocks) {
+        zeroLevel = quantile(values_, 0.5);
+        noiseVariance_ = std::max(quantile(unlitVariances_, 0.5), 0.25f);
+    } else {
+        noiseVariance_ = kFallbackNoiseVariance;
+        zeroLevel = channels == 3 ? kZeroLevelPerSd * std::sqrt(noiseVariance_) : 0.0f;
+    }
 
     // What the table's code would correlate with where the code's amplitude is g: S = g P + noise gives
     // r = g sd(P) / sqrt(g^2 var(P) + noise). The camera's blur is predicted only approximately, so the

@@ -99,7 +99,8 @@ public:
 private:
     void segmentByCode(const cv::Mat& texture, const cv::Mat& subtraction, cv::Mat& mask);
     void segmentAsPaper(const cv::Mat& texture, cv::Mat& mask);
-    void classifyBlocks();
+    // channels: the texture's, which set the level of S where nothing is lit.
+    void classifyBlocks(int channels);
     // Relabels the 8-connected blocks of class `from` around `start` as `to`; component_ receives them.
     // Returns their number.
     int floodComponent(int start, uchar from, uchar to);
@@ -141,6 +142,7 @@ private:
     std::vector<int> litPatch_;    // S around one block, as labelPixels' lit test counts it
     std::vector<int> litColumns_;  // one row of litPatch_'s sums over the lit test's height
     std::vector<float> values_;
+    std::vector<float> unlitVariances_;  // of S in each block beyond the projection
     std::vector<int> queue_;
     std::vector<int> component_;
     std::vector<int> blocksToHand_;     // block grid: blocks to the nearest hand block (8-connected)
