@@ -11,7 +11,6 @@ namespace everytouch::core {
 namespace {
 
 constexpr int kSums = 6;
-constexpr int kCodePixels = 5;  // the sum that counts a block's pixels on the code
 using BlockSums = cv::Vec<double, kSums>;
 
 // Per-block count, sum P and sum P^2 of the predicted code; blocks that reach outside the projection count 0.
@@ -163,7 +162,7 @@ void measureCodeEvidence(const cv::Mat& subtraction, const TableCode& tableCode,
             } else {
                 b[2] = b[3] = b[4] = 0.0;
             }
-            b[kCodePixels] = c[0];
+            b[5] = c[0];
         }
     }
     evidence.integral.create(rows + 1, cols + 1, CV_64FC(kSums));
@@ -181,15 +180,6 @@ void measureCodeEvidence(const cv::Mat& subtraction, const TableCode& tableCode,
             }
     }
     windowStatistics(evidence.integral, evidence.windowBlocks, blockPx, evidence.narrow);
-}
-
-bool CodeEvidence::beyondProjection(int by, int bx) const {
-    const int rows = blockSums.rows, cols = blockSums.cols, reach = windowBlocks / 2;
-    for (int y = std::max(by - reach, 0); y <= std::min(by + reach, rows - 1); ++y)
-        for (int x = std::max(bx - reach, 0); x <= std::min(bx + reach, cols - 1); ++x)
-            if (blockSums.ptr<BlockSums>(y)[x][kCodePixels] > 0.0)
-                return false;
-    return true;
 }
 
 int CodeEvidence::widePixels() const {

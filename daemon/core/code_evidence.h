@@ -35,9 +35,6 @@ struct CodeEvidence {
         int pixels = 0;        // pixels in a whole window
     };
     Window narrow;
-    // Whether no projector light reaches the narrow window around the block: none of its pixels lies on the
-    // code. The grid's edge, which cuts the window short, is no sign of that.
-    bool beyondProjection(int by, int bx) const;
     // The wide window centred on one block, and the pixels it holds.
     WindowStatistics wideAt(int by, int bx) const;
     int widePixels() const;

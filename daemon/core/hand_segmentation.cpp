@@ -155,7 +155,7 @@ private:
 constexpr float kFallbackNoiseVariance = 4.0f;
 // Windows beyond the projection needed to measure the noise there: the median of their variances then lies
 // within a few per cent of the noise's.
-constexpr std::size_t kMinUnlitBlocks = 32;
+constexpr std::size_t kMinUnlitWindows = 32;
 // Where nothing is lit, S of a colour camera is the largest of three channels' noise: its mean is 0.846 and
 // its standard deviation 0.748 of one channel's, so its level is 1.13 standard deviations of S itself.
 constexpr float kZeroLevelPerSd = 1.1314f;
@@ -263,6 +263,23 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
                 cv::countNonZero(display(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx))) ==
                 blockPx * blockPx;
     displayBlocks_ = cv::Mat::zeros(blocks, CV_8UC1);
+    // The windows that no projector light reaches, where the noise of S is measured: whole windows (one that
+    // the image's edge cuts short is no view beyond the projection) holding no pixel on the code, so that
+    // the projection's blurred edge stays out.
+    cv::Mat blockOnCode(blocks, CV_8UC1);
+    for (int by = 0; by < blocks.height; ++by)
+        for (int bx = 0; bx < blocks.width; ++bx) {
+            double highest = 0.0;
+            cv::minMaxLoc(tableCode_.predicted(cv::Rect(bx * blockPx, by * blockPx, blockPx, blockPx)),
+                          nullptr, &highest);
+            blockOnCode.at<uchar>(by, bx) = highest >= 0.0;  // negative where no projector pixel lands
+        }
+    unlitWindows_.clear();
+    for (int by = reach; by < blocks.height - reach; ++by)
+        for (int bx = reach; bx < blocks.width - reach; ++bx)
+            if (cv::countNonZero(
+                    blockOnCode(cv::Rect(bx - reach, by - reach, 2 * reach + 1, 2 * reach + 1))) == 0)
+                unlitWindows_.push_back(by * blocks.width + bx);
     // The per-frame buffers at their largest, so that no frame allocates.
     const std::size_t blockCount = static_cast<std::size_t>(blocks.area());
     values_.reserve(blockCount);
@@ -339,20 +356,16 @@ void HandSegmenter::classifyBlocks(int channels) {
     const CodeEvidence::Window& narrow = evidence_.narrow;
     const int rows = narrow.correlation.rows, cols = narrow.correlation.cols;
     // Where the camera sees beyond the projection S holds nothing but noise: its level (which the largest
-    // of three channels' differences lifts above zero) and its variance, over the whole windows that hold no
-    // code pixel, so that the projection's blurred edge stays out. A window that the image's edge cuts short
-    // is no view beyond the projection: a camera framed on the projection has none.
-    const int reach = evidence_.windowBlocks / 2;
+    // of three channels' differences lifts above zero) and its variance. A camera framed on the projection
+    // has no such view.
     values_.clear();
     unlitVariances_.clear();
-    for (int by = reach; by < rows - reach; ++by)
-        for (int bx = reach; bx < cols - reach; ++bx)
-            if (evidence_.beyondProjection(by, bx)) {
-                values_.push_back(narrow.meanS.at<float>(by, bx));
-                unlitVariances_.push_back(narrow.varianceS.at<float>(by, bx));
-            }
+    for (const int window : unlitWindows_) {
+        values_.push_back(narrow.meanS.at<float>(window));
+        unlitVariances_.push_back(narrow.varianceS.at<float>(window));
+    }
     float zeroLevel = 0.0f;
-    if (values_.size() >= kMinUnlitBlocks) {
+    if (values_.size() >= kMinUnlitWindows) {
         zeroLevel = quantile(values_, 0.5);
         noiseVariance_ = std::max(quantile(unlitVariances_, 0.5), 0.25f);
     } else {

@@ -124,8 +124,9 @@ private:
 
     SegmentationOptions options_;
     TableCode tableCode_;
-    cv::Rect displayBox_;    // the display's bounding box in the camera
-    cv::Mat displayBlocks_;  // CV_8UC1, block grid: 1 where the whole window lies on the display
+    cv::Rect displayBox_;            // the display's bounding box in the camera
+    cv::Mat displayBlocks_;          // CV_8UC1, block grid: 1 where the whole window lies on the display
+    std::vector<int> unlitWindows_;  // blocks (row-major) whose whole window lies beyond the projection
     cv::Mat judgedRegion_;
     double pixelsPerMm_ = 1.0;
     float litAmplitude_ = 0.0f;
@@ -142,7 +143,7 @@ private:
     std::vector<int> litPatch_;    // S around one block, as labelPixels' lit test counts it
     std::vector<int> litColumns_;  // one row of litPatch_'s sums over the lit test's height
     std::vector<float> values_;
-    std::vector<float> unlitVariances_;  // of S in each block beyond the projection
+    std::vector<float> unlitVariances_;  // of S in each window of unlitWindows_
     std::vector<int> queue_;
     std::vector<int> component_;
     std::vector<int> blocksToHand_;     // block grid: blocks to the nearest hand block (8-connected)
