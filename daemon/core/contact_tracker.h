@@ -27,7 +27,7 @@ struct FingerObservation {
     // observation keeps its track, and `display` is the point on the table (padHeightMm is not used).
     bool heightKnown = true;
     // Without a height: the code on the fingertip still matches the heights a touching fingertip shows
-    // better than any higher one (SurfaceHeight::favoursUpTo). A touching finger stays down through such
+    // better than any higher one (SurfaceHeight::favoursPadUpTo). A touching finger stays down through such
     // frames: they do not count towards maxUnmeasuredFrames.
     bool codeFavoursTable = false;
 };

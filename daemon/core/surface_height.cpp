@@ -1,6 +1,7 @@
 #include "core/surface_height.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -83,6 +84,12 @@ std::optional<std::string> HeightOptions::validate() const {
         return "significance: must be a positive number of standard deviations";
     if (!(distinctness >= 0.0) || !std::isfinite(distinctness))
         return "distinctness: must be a number of standard deviations, not negative";
+    if (!(thicknessPerWidth > 0.0 && thicknessPerWidth <= 2.0))
+        return "thicknessPerWidth: must be in (0, 2]";
+    if (!(maxSlope >= 0.0 && maxSlope <= 5.0))
+        return "maxSlope: must be in [0, 5] mm per mm";
+    if (!(slopeStep > 0.0 && slopeStep <= 5.0))
+        return "slopeStep: must be in (0, 5] mm per mm";
     return std::nullopt;
 }
 
@@ -91,6 +98,7 @@ void HeightEvidence::clear(std::size_t heights) {
     codeVariance.assign(heights, 0.0);
     subtractionVariance = 0.0;
     pixels = 0.0;
+    topAbovePadTimesPixels = 0.0;
 }
 
 void HeightEvidence::add(const HeightEvidence& other, double weight) {
@@ -102,11 +110,14 @@ void HeightEvidence::add(const HeightEvidence& other, double weight) {
     }
     subtractionVariance += weight * other.subtractionVariance;
     pixels += weight * other.pixels;
+    topAbovePadTimesPixels += weight * other.topAbovePadTimesPixels;
 }
 
 SurfaceHeight::SurfaceHeight(const HeightOptions& options) : options_(options) {
     if (auto problem = options.validate())
         throw std::invalid_argument("height options: " + *problem);
+    heightCount_ = static_cast<std::size_t>(std::floor(options_.maxHeightMm / options_.stepMm + 1e-9)) + 1;
+    slopeCount_ = static_cast<std::size_t>(std::floor(options_.maxSlope / options_.slopeStep + 1e-9)) + 1;
 }
 
 void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& pattern) {
@@ -130,7 +141,6 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     pattern.convertTo(panel_, CV_32FC1);
     cv::GaussianBlur(panel_, panel_, cv::Size(), sigma);
 
-    heightCount_ = static_cast<std::size_t>(std::floor(options_.maxHeightMm / options_.stepMm + 1e-9)) + 1;
     // The camera's rays in table coordinates and the projector's view of them: a pixel's ray meets the plane
     // at height d in a point the projector sees at a + d b (homogeneous), a and b from the ray alone.
     const Eigen::Matrix3d cameraToTableRotation = calibration.tableToCamera.rotation().transpose();
@@ -146,6 +156,8 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     gradients_.reserve(kTypicalMostPixels);
     residuals_.reserve(kTypicalMostPixels);
     rays_.reserve(kTypicalMostPixels);
+    blendOffsets_.reserve(kTypicalMostPixels);
+    blendWeights_.reserve(kTypicalMostPixels);
 
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     undistorted_.create(calibration.cameraSize, CV_32FC2);
@@ -158,6 +170,7 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
 }
 
 void SurfaceHeight::clearPixels() {
+    shape_.clear();
     values_.clear();
     points_.clear();
     gradients_.clear();
@@ -188,6 +201,31 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
     const int y0 = std::max(1, static_cast<int>(std::floor(centre.y() - radius)));
     const int y1 = std::min(plus.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
     clearPixels();
+    const auto undistortedAt = [&](const Eigen::Vector2d& p) {
+        const cv::Vec2f& u =
+            undistorted_.at<cv::Vec2f>(std::clamp(static_cast<int>(std::lround(p.y())), 0, plus.rows - 1),
+                                       std::clamp(static_cast<int>(std::lround(p.x())), 0, plus.cols - 1));
+        return Eigen::Vector2d(u[0], u[1]);
+    };
+    // The fingertip's shape: a cap as wide as the finger around a centre half a width behind the tip, then
+    // the finger, its cross-section an ellipse thicknessPerWidth as thick as wide. Each pixel sees it as
+    // far below the top as the ellipse falls away at its distance from the axis (or from the cap's
+    // centre), times the cosine of its ray's angle from the vertical.
+    const double halfWidthPx = 0.5 * widthPx;
+    const Eigen::Vector2d capCentre = tip - halfWidthPx * direction;
+    const double mmPerPx =
+        (onTable(undistortedAt(capCentre)) - onTable(undistortedAt(tip))).norm() / halfWidthPx;
+    const double halfThicknessMm = options_.thicknessPerWidth * halfWidthPx * mmPerPx;
+    const auto addShape = [&](int x, int y) {
+        const Eigen::Vector2d offset = Eigen::Vector2d(x, y) - capCentre;
+        const double behind = -offset.dot(direction);
+        const double fromAxis =
+            behind > 0.0 ? std::abs(offset.x() * direction.y() - offset.y() * direction.x()) : offset.norm();
+        const double t = std::min(1.0, fromAxis / halfWidthPx);
+        const double belowTopAlongView = halfThicknessMm * (1.0 - std::sqrt(1.0 - t * t));
+        shape_.push_back({static_cast<float>(std::max(0.0, behind) * mmPerPx),
+                          static_cast<float>(belowTopAlongView * verticalCosine(undistortedAt({x, y})))});
+    };
     for (int y = y0; y <= y1; ++y) {
         const uchar* above = handMask.ptr<uchar>(y - 1);
         const uchar* m = handMask.ptr<uchar>(y);
@@ -200,16 +238,35 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
                 continue;
             addValue(colour ? channelSum<3, -1>(plus, minus, x, y) : channelSum<1, -1>(plus, minus, x, y), x,
                      y);
+            addShape(x, y);
             if (options_.explainMotion)
                 gradients_.push_back(colour ? textureGradient<3>(plus, minus, x, y)
                                             : textureGradient<1>(plus, minus, x, y));
         }
     }
     measurePixels(evidence);
+    // The top of the cap as the camera sees it lies a half thickness above the cap's centre times the
+    // cosine of the view's angle from the vertical, the lowest point a half thickness below.
+    evidence.topAbovePadTimesPixels =
+        evidence.pixels * halfThicknessMm * (1.0 + verticalCosine(undistortedAt(capCentre)));
+}
+
+double SurfaceHeight::verticalCosine(const Eigen::Vector2d& undistorted) const {
+    const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0);
+    return std::abs(ray.z()) / ray.norm();
+}
+
+Eigen::Vector2d SurfaceHeight::onTable(const Eigen::Vector2d& undistorted) const {
+    const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0);
+    if (std::abs(ray.z()) < 1e-12)
+        return cameraCentre_.head<2>();
+    return (cameraCentre_ - cameraCentre_.z() / ray.z() * ray).head<2>();
 }
 
 void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) {
-    evidence.clear(heightCount_);
+    const bool shaped = shape_.size() == values_.size();
+    const std::size_t slopes = shaped ? slopeCount_ : 1;
+    evidence.clear(heightCount_ * slopes);
     const std::size_t n = values_.size();
     if (n < 8)
         return;
@@ -232,68 +289,134 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
         const Eigen::Vector3d along = projectorRotation_ * ray / ray.z();
         rays_.add(epipole_ - cameraCentre_.z() * along, dStep * along);
     }
-    const BilinearSampler sample(panel_);
-    for (std::size_t h = 0, k = 0; h < heightCount_; h += stride, ++k) {
-        const auto sums = sampleAlongRays(sample, static_cast<float>(k));
-        evidence.covariance[h] = sums.covariance;
-        evidence.codeVariance[h] =
-            std::max(0.0, sums.squares - sums.values * sums.values / static_cast<double>(n));
+    // Every hypothesis samples the predicted code somewhere along each pixel's ray: a whole number of
+    // candidate steps from the table plus the pixel's own extra steps for the shape and slope. The code is
+    // sampled once per pixel at every whole step the hypotheses reach (its profile along the ray) and
+    // interpolated between them, so that each hypothesis costs a blend instead of a projection.
+    const std::size_t candidates = (heightCount_ + stride - 1) / stride;
+    const auto extraSteps = [&](std::size_t slope, std::size_t i) {
+        return shaped ? static_cast<float>((slopeOf(slope) * shape_[i].behindCapMm - shape_[i].belowTopMm) /
+                                           dStep)
+                      : 0.0f;
+    };
+    float lowest = 0.0f, highest = 0.0f;
+    for (std::size_t slope = 0; slope < slopes; ++slope)
+        for (std::size_t i = 0; i < n; ++i) {
+            lowest = std::min(lowest, extraSteps(slope, i));
+            highest = std::max(highest, extraSteps(slope, i));
+        }
+    const std::size_t padded = (candidates + kLanes - 1) / kLanes * kLanes;
+    const int firstStep = static_cast<int>(std::floor(lowest));
+    const std::size_t length =
+        static_cast<std::size_t>(static_cast<int>(std::floor(highest)) - firstStep) + padded + 1;
+    sampleProfiles(BilinearSampler(panel_), firstStep, length);
+    blendOffsets_.resize(n);
+    blendWeights_.resize(n);
+    for (std::size_t slope = 0; slope < slopes; ++slope) {
+        for (std::size_t i = 0; i < n; ++i) {
+            const float extra = extraSteps(slope, i);
+            const float whole = std::floor(extra);
+            blendOffsets_[i] = i * length + static_cast<std::size_t>(static_cast<int>(whole) - firstStep);
+            blendWeights_[i] = extra - whole;
+        }
+        for (std::size_t k = 0; k < candidates; k += kLanes) {
+            std::array<float, kLanes> values{}, squares{}, products{};
+            accumulateBlends(k, values, squares, products);
+            for (std::size_t lane = 0; lane < kLanes && k + lane < candidates; ++lane) {
+                const std::size_t at = slope * heightCount_ + (k + lane) * stride;
+                evidence.covariance[at] = products[lane];
+                evidence.codeVariance[at] = std::max(
+                    0.0, static_cast<double>(squares[lane]) -
+                             static_cast<double>(values[lane]) * values[lane] / static_cast<double>(n));
+            }
+        }
     }
 }
 
-SurfaceHeight::CodeSums SurfaceHeight::sampleAlongRays(const BilinearSampler& sample, float steps) const {
+void SurfaceHeight::accumulateBlends(std::size_t candidate, std::array<float, kLanes>& values,
+                                     std::array<float, kLanes>& squares,
+                                     std::array<float, kLanes>& products) const {
     const std::size_t n = residuals_.size();
-    std::size_t i = 0;
-    CodeSums sums;
 #if CV_SIMD128
-    // Four pixels at a time: the positions, their division and the interpolation in vectors, only the
-    // panel's reads one by one.
-    const cv::v_float32x4 k = cv::v_setall_f32(steps), zero = cv::v_setzero_f32();
-    const cv::v_float32x4 lastX = cv::v_setall_f32(static_cast<float>(sample.lastX()));
-    const cv::v_float32x4 lastY = cv::v_setall_f32(static_cast<float>(sample.lastY()));
-    const cv::v_int32x4 rowStep = cv::v_setall_s32(static_cast<int>(sample.step()));
-    cv::v_float32x4 sumValues = zero, sumSquares = zero, sumProducts = zero;
-    alignas(16) int offsets[4];
-    for (; i + 4 <= n; i += 4) {
-        const cv::v_float32x4 inverseZ =
-            cv::v_setall_f32(1.0f) / cv::v_muladd(k, cv::v_load(&rays_.stepZ[i]), cv::v_load(&rays_.z[i]));
-        cv::v_float32x4 x = cv::v_muladd(k, cv::v_load(&rays_.stepX[i]), cv::v_load(&rays_.x[i])) * inverseZ;
-        cv::v_float32x4 y = cv::v_muladd(k, cv::v_load(&rays_.stepY[i]), cv::v_load(&rays_.y[i])) * inverseZ;
-        const cv::v_float32x4 inside = (x >= zero) & (y >= zero) & (x < lastX) & (y < lastY);
-        x = cv::v_select(inside, x, zero);
-        y = cv::v_select(inside, y, zero);
-        const cv::v_int32x4 x0 = cv::v_trunc(x), y0 = cv::v_trunc(y);
-        const cv::v_float32x4 fx = x - cv::v_cvt_f32(x0), fy = y - cv::v_cvt_f32(y0);
-        cv::v_store_aligned(offsets, y0 * rowStep + x0);
-        const float* p0 = sample.data() + offsets[0];
-        const float* p1 = sample.data() + offsets[1];
-        const float* p2 = sample.data() + offsets[2];
-        const float* p3 = sample.data() + offsets[3];
-        const std::ptrdiff_t down = sample.step();
-        const cv::v_float32x4 topLeft(p0[0], p1[0], p2[0], p3[0]), topRight(p0[1], p1[1], p2[1], p3[1]);
-        const cv::v_float32x4 bottomLeft(p0[down], p1[down], p2[down], p3[down]);
-        const cv::v_float32x4 bottomRight(p0[down + 1], p1[down + 1], p2[down + 1], p3[down + 1]);
-        const cv::v_float32x4 top = cv::v_muladd(topRight - topLeft, fx, topLeft);
-        const cv::v_float32x4 bottom = cv::v_muladd(bottomRight - bottomLeft, fx, bottomLeft);
-        const cv::v_float32x4 value =
-            cv::v_select(inside, cv::v_max(zero, cv::v_muladd(bottom - top, fy, top)), zero);
+    static_assert(kLanes == 4);
+    cv::v_float32x4 sumValues = cv::v_setzero_f32(), sumSquares = sumValues, sumProducts = sumValues;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float* at = profiles_.data() + blendOffsets_[i] + candidate;
+        const cv::v_float32x4 low = cv::v_load(at), high = cv::v_load(at + 1);
+        const cv::v_float32x4 value = cv::v_muladd(high - low, cv::v_setall_f32(blendWeights_[i]), low);
         sumValues += value;
         sumSquares = cv::v_muladd(value, value, sumSquares);
-        sumProducts = cv::v_muladd(cv::v_load(&residuals_[i]), value, sumProducts);
+        sumProducts = cv::v_muladd(cv::v_setall_f32(residuals_[i]), value, sumProducts);
     }
-    sums.values = cv::v_reduce_sum(sumValues);
-    sums.squares = cv::v_reduce_sum(sumSquares);
-    sums.covariance = cv::v_reduce_sum(sumProducts);
+    cv::v_store(values.data(), sumValues);
+    cv::v_store(squares.data(), sumSquares);
+    cv::v_store(products.data(), sumProducts);
+#else
+    for (std::size_t i = 0; i < n; ++i) {
+        const float* at = profiles_.data() + blendOffsets_[i] + candidate;
+        for (std::size_t lane = 0; lane < kLanes; ++lane) {
+            const float value = at[lane] + blendWeights_[i] * (at[lane + 1] - at[lane]);
+            values[lane] += value;
+            squares[lane] += value * value;
+            products[lane] += residuals_[i] * value;
+        }
+    }
 #endif
-    for (; i < n; ++i) {
-        const float inverseZ = 1.0f / (rays_.z[i] + steps * rays_.stepZ[i]);
-        const float value = std::max(0.0f, sample((rays_.x[i] + steps * rays_.stepX[i]) * inverseZ,
-                                                  (rays_.y[i] + steps * rays_.stepY[i]) * inverseZ));
-        sums.values += value;
-        sums.squares += value * value;
-        sums.covariance += residuals_[i] * value;
+}
+
+void SurfaceHeight::sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length) {
+    const std::size_t n = residuals_.size();
+    profiles_.resize(n * length);
+    for (std::size_t j = 0; j < length; ++j) {
+        const float steps = static_cast<float>(firstStep + static_cast<int>(j));
+        std::size_t i = 0;
+#if CV_SIMD128
+        // Four pixels at a time: the positions, their division and the interpolation in vectors, only the
+        // panel's reads one by one.
+        const cv::v_float32x4 k = cv::v_setall_f32(steps);
+        const cv::v_float32x4 zero = cv::v_setzero_f32();
+        const cv::v_float32x4 lastX = cv::v_setall_f32(static_cast<float>(sample.lastX()));
+        const cv::v_float32x4 lastY = cv::v_setall_f32(static_cast<float>(sample.lastY()));
+        const cv::v_int32x4 rowStep = cv::v_setall_s32(static_cast<int>(sample.step()));
+        alignas(16) int offsets[4];
+        alignas(16) float result[4];
+        for (; i + 4 <= n; i += 4) {
+            const cv::v_float32x4 inverseZ =
+                cv::v_setall_f32(1.0f) /
+                cv::v_muladd(k, cv::v_load(&rays_.stepZ[i]), cv::v_load(&rays_.z[i]));
+            cv::v_float32x4 x =
+                cv::v_muladd(k, cv::v_load(&rays_.stepX[i]), cv::v_load(&rays_.x[i])) * inverseZ;
+            cv::v_float32x4 y =
+                cv::v_muladd(k, cv::v_load(&rays_.stepY[i]), cv::v_load(&rays_.y[i])) * inverseZ;
+            const cv::v_float32x4 inside = (x >= zero) & (y >= zero) & (x < lastX) & (y < lastY);
+            x = cv::v_select(inside, x, zero);
+            y = cv::v_select(inside, y, zero);
+            const cv::v_int32x4 x0 = cv::v_trunc(x), y0 = cv::v_trunc(y);
+            const cv::v_float32x4 fx = x - cv::v_cvt_f32(x0), fy = y - cv::v_cvt_f32(y0);
+            cv::v_store_aligned(offsets, y0 * rowStep + x0);
+            const float* p0 = sample.data() + offsets[0];
+            const float* p1 = sample.data() + offsets[1];
+            const float* p2 = sample.data() + offsets[2];
+            const float* p3 = sample.data() + offsets[3];
+            const std::ptrdiff_t down = sample.step();
+            const cv::v_float32x4 topLeft(p0[0], p1[0], p2[0], p3[0]), topRight(p0[1], p1[1], p2[1], p3[1]);
+            const cv::v_float32x4 bottomLeft(p0[down], p1[down], p2[down], p3[down]);
+            const cv::v_float32x4 bottomRight(p0[down + 1], p1[down + 1], p2[down + 1], p3[down + 1]);
+            const cv::v_float32x4 top = cv::v_muladd(topRight - topLeft, fx, topLeft);
+            const cv::v_float32x4 bottom = cv::v_muladd(bottomRight - bottomLeft, fx, bottomLeft);
+            cv::v_store_aligned(
+                result, cv::v_select(inside, cv::v_max(zero, cv::v_muladd(bottom - top, fy, top)), zero));
+            for (std::size_t lane = 0; lane < 4; ++lane)
+                profiles_[(i + lane) * length + j] = result[lane];
+        }
+#endif
+        for (; i < n; ++i) {
+            const float inverseZ = 1.0f / (rays_.z[i] + steps * rays_.stepZ[i]);
+            profiles_[i * length + j] =
+                std::max(0.0f, sample((rays_.x[i] + steps * rays_.stepX[i]) * inverseZ,
+                                      (rays_.y[i] + steps * rays_.stepY[i]) * inverseZ));
+        }
     }
-    return sums;
 }
 
 void SurfaceHeight::PanelRays::clear() {
@@ -345,36 +468,62 @@ void SurfaceHeight::fitResiduals() {
         residuals_[i] = static_cast<float>(values_[i] - regressor(i).dot(fit));
 }
 
-bool SurfaceHeight::favoursUpTo(const HeightEvidence& evidence, double heightMm) const {
-    if (evidence.covariance.empty() || evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)
+namespace {
+
+// The evidence's correlation at each candidate height, the best over its slopes.
+struct HeightProfile {
+    const HeightEvidence& evidence;
+    std::size_t heights;
+
+    bool measured(std::size_t h) const {
+        for (std::size_t at = h; at < evidence.codeVariance.size(); at += heights)
+            if (evidence.codeVariance[at] > 0.0)
+                return true;
         return false;
+    }
+    // The best correlation at height h and the slope it was found at; -2 without evidence.
+    std::pair<double, std::size_t> best(std::size_t h) const {
+        std::pair<double, std::size_t> result{-2.0, 0};
+        for (std::size_t at = h, s = 0; at < evidence.codeVariance.size(); at += heights, ++s) {
+            const double denominator = std::sqrt(evidence.codeVariance[at] * evidence.subtractionVariance);
+            if (denominator > 0.0 && evidence.covariance[at] / denominator > result.first)
+                result = {evidence.covariance[at] / denominator, s};
+        }
+        return result;
+    }
+    double correlation(std::size_t h) const { return best(h).first; }
+};
+
+}  // namespace
+
+bool SurfaceHeight::favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm) const {
+    if (evidence.covariance.size() < heightCount_ || evidence.pixels < 8 ||
+        evidence.subtractionVariance <= 0.0)
+        return false;
+    const HeightProfile profile{evidence, heightCount_};
+    const double heightMm = padHeightMm + evidence.topAbovePadTimesPixels / evidence.pixels;
     double below = -2.0, above = -2.0;
-    for (std::size_t h = 0; h < evidence.covariance.size(); ++h) {
-        if (evidence.codeVariance[h] <= 0.0)
-            continue;
-        const double r =
-            evidence.covariance[h] / std::sqrt(evidence.codeVariance[h] * evidence.subtractionVariance);
+    for (std::size_t h = 0; h < heightCount_; ++h) {
         double& side = heightOf(h) <= heightMm ? below : above;
-        side = std::max(side, r);
+        side = std::max(side, profile.correlation(h));
     }
     return below > above && below >= options_.significance * std::sqrt(2.0 / evidence.pixels);
 }
 
 HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     HeightEstimate result;
-    const std::size_t count = evidence.covariance.size();
-    if (count == 0 || evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)
+    const std::size_t count = heightCount_;
+    if (count == 0 || evidence.covariance.size() < count || evidence.pixels < 8 ||
+        evidence.subtractionVariance <= 0.0)
         return result;
-    std::size_t best = 0;
+    const HeightProfile profile{evidence, count};
+    std::size_t best = 0, bestSlope = 0;
     double bestCorrelation = -2.0;
-    const auto correlationAt = [&](std::size_t h) {
-        const double denominator = std::sqrt(evidence.codeVariance[h] * evidence.subtractionVariance);
-        return denominator > 0.0 ? evidence.covariance[h] / denominator : 0.0;
-    };
     for (std::size_t h = 0; h < count; ++h)
-        if (const double r = correlationAt(h); evidence.codeVariance[h] > 0.0 && r > bestCorrelation) {
+        if (const auto [r, slope] = profile.best(h); r > bestCorrelation) {
             bestCorrelation = r;
             best = h;
+            bestSlope = slope;
         }
     // Chance correlation over the region: neighbouring pixels share light through the blurs, about two
     // pixels per independent sample.
@@ -393,7 +542,7 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     // Heights without evidence (a coarse look) are stepped over.
     const double half = 0.5 * bestCorrelation;
     const auto withinPeak = [&](std::size_t h) {
-        return evidence.codeVariance[h] <= 0.0 || correlationAt(h) > half;
+        return !profile.measured(h) || profile.correlation(h) > half;
     };
     std::size_t low = best, high = best;
     while (low > 0 && withinPeak(low))
@@ -402,22 +551,24 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
         ++high;
     double runnerUp = -1.0;
     for (std::size_t h = 0; h < count; ++h)
-        if ((h < low || h > high) && evidence.codeVariance[h] > 0.0)
-            runnerUp = std::max(runnerUp, correlationAt(h));
+        if ((h < low || h > high) && profile.measured(h))
+            runnerUp = std::max(runnerUp, profile.correlation(h));
     // Two correlations of chance differ by sqrt(2) times one's deviation.
     if (bestCorrelation - runnerUp < options_.distinctness * std::sqrt(2.0) * chance)
         return result;
     // The peak to a fraction of a step: the parabola through the best height and its neighbours.
     double offset = 0.0;
-    if (best > 0 && best + 1 < count && evidence.codeVariance[best - 1] > 0.0 &&
-        evidence.codeVariance[best + 1] > 0.0) {
-        const double a = correlationAt(best - 1), b = bestCorrelation, c = correlationAt(best + 1);
+    if (best > 0 && best + 1 < count && profile.measured(best - 1) && profile.measured(best + 1)) {
+        const double a = profile.correlation(best - 1), b = bestCorrelation,
+                     c = profile.correlation(best + 1);
         const double curvature = a - 2 * b + c;
         if (curvature < 0.0)
             offset = std::clamp(0.5 * (a - c) / curvature, -0.5, 0.5);
     }
     result.valid = true;
     result.heightMm = (static_cast<double>(best) + offset) * options_.stepMm;
+    result.padHeightMm = std::max(0.0, result.heightMm - evidence.topAbovePadTimesPixels / evidence.pixels);
+    result.slope = evidence.covariance.size() > count ? slopeOf(bestSlope) : 0.0;
     // The peak's width in height over its height above chance: a sharp, strong peak pins the height down.
     result.uncertaintyMm = options_.stepMm * chance / std::max(bestCorrelation, chance) * 4.0;
     return result;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,7 +17,9 @@ namespace everytouch::core {
 // (paper section VI.C-D, beyond its single 36-bit test): the light a camera pixel sees on a surface at height
 // d came from the projector pixel that the homography of the plane at d names. For each candidate height the
 // code is predicted over the whole visible fingertip, as the camera blurs it and as skin scatters it, and
-// correlated with S there; the best height is the surface's.
+// correlated with S there; the best height is the surface's. A fingertip is no plane: its predicted code
+// follows the shape of a fingertip (a capsule whose cap is as wide as the finger) tilted towards the hand by
+// a slope searched with the height.
 struct HeightOptions {
     double maxHeightMm = 48.0;  // candidate heights from 0 up to this (mm)
     double stepMm = 1.0;        // between candidate heights (mm): a fifth of a projector pixel of parallax
@@ -28,10 +31,11 @@ struct HeightOptions {
     // fingertip position to the next (docs/detection.md).
     double skinScatterMm = 0.5;
     // The fingertip region: hand pixels within regionWidths finger widths of a point centreBehindWidths
-    // behind the silhouette's end: the last joint's end, whose height follows the pad's more closely than
-    // the finger's back further up, which tilts with the finger.
-    double regionWidths = 0.5;
-    double centreBehindWidths = 0.25;
+    // behind the silhouette's end, the centre of the fingertip's cap. Three quarters of a width: with the
+    // shape below, the larger region's pixels add evidence instead of spreading it over heights; with a
+    // plane, half a width around a quarter behind the end was best.
+    double regionWidths = 0.75;
+    double centreBehindWidths = 0.5;
     // A correlation must exceed this many standard deviations of chance to count as seeing the code.
     double significance = 3.0;
     // The best height must beat every other peak of the correlation by this many standard deviations of the
@@ -46,6 +50,16 @@ struct HeightOptions {
     // cleared of what the gradient explains, then correlated with the code. On the drag scenario this reads
     // a sliding fingertip's height in 0.53 of its frames instead of 0.15 (surface_height_rendered_test).
     bool explainMotion = true;
+    // The fingertip's shape: its thickness over its width (the last joint of a finger is about 12 mm thick
+    // and 16 mm wide), which sets how far the cap and the finger's sides fall away from their top.
+    double thicknessPerWidth = 0.75;
+    // The finger's back rises from its cap towards the hand by a slope (mm per mm along the finger, over the
+    // table) searched from 0 up to maxSlope in slopeStep: from a finger lying flat to one pointing down at
+    // 63 degrees. A camera far from the projector sees 1 mm of height move the code by 0.7 projector pixels,
+    // and there a plane through the fingertip matched the code over too little of it to tell touching from
+    // hovering (docs/detection.md, "Other rig geometries").
+    double maxSlope = 2.0;
+    double slopeStep = 0.5;
 
     std::optional<std::string> validate() const;
 };
@@ -58,6 +72,9 @@ struct HeightEvidence {
     std::vector<double> codeVariance;
     double subtractionVariance = 0.0;
     double pixels = 0.0;
+    // How far the top of the shape the height was sought with lies above its lowest point, the pad (mm),
+    // times pixels; 0 for a region searched flat.
+    double topAbovePadTimesPixels = 0.0;
 
     void clear(std::size_t heights);
     void add(const HeightEvidence& other, double weight);
@@ -67,9 +84,11 @@ struct HeightEstimate {
     // The code was seen on the fingertip well enough to tell a height, its best height lies below the top
     // of the range, and no other height comes near it.
     bool valid = false;
-    double heightMm = 0.0;       // of the visible surface above the table
+    double heightMm = 0.0;       // of the visible surface above the table: for a fingertip, its top
+    double padHeightMm = 0.0;    // of its lowest point, by the fingertip's shape; heightMm otherwise
     double correlation = 0.0;    // at that height
     double uncertaintyMm = 0.0;  // one standard deviation
+    double slope = 0.0;          // the surface's rise towards the hand, mm per mm
 };
 
 class BilinearSampler;
@@ -83,6 +102,9 @@ public:
     void setRig(const Calibration& calibration, const cv::Mat& pattern);
 
     std::size_t heights() const { return heightCount_; }
+    // Candidate (height, slope) pairs in a fingertip's evidence: heights() per slope, slope by slope.
+    std::size_t hypotheses() const { return heightCount_ * slopeCount_; }
+    double slopeOf(std::size_t candidate) const { return candidate * options_.slopeStep; }
     double heightOf(std::size_t candidate) const { return candidate * options_.stepMm; }
 
     // Gathers the evidence of one frame pair around a fingertip (camera pixels, raw) of `widthPx` whose
@@ -104,8 +126,8 @@ public:
     // The height the evidence supports best.
     HeightEstimate estimate(const HeightEvidence& evidence) const;
     // Whether evidence that gives no height (its peak not distinct, or at the top of the range) still leans:
-    // its best match among the heights up to `heightMm` is significant and beats every height above.
-    bool favoursUpTo(const HeightEvidence& evidence, double heightMm) const;
+    // its best match among the pad heights up to `padHeightMm` is significant and beats every one above.
+    bool favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm) const;
 
 private:
     // Where the projector sees each pixel's ray: on the table and a step up to the next candidate height
@@ -118,20 +140,34 @@ private:
         void add(const Eigen::Vector3d& onTable, const Eigen::Vector3d& step);
         void addOutside();  // a ray that meets no candidate plane: it samples nothing
     };
-    struct CodeSums {
-        double values = 0.0, squares = 0.0, covariance = 0.0;  // of the predicted code, with the residuals
-    };
+    static constexpr std::size_t kLanes = 4;  // candidate heights summed together
 
     void addValue(float value, int x, int y);
     // residuals_: values_ less their mean and, when gradients_ were gathered, what the gradients explain.
     void fitResiduals();
-    // The predicted code at `steps` steps up every ray, summed over the region's pixels.
-    CodeSums sampleAlongRays(const BilinearSampler& sample, float steps) const;
+    // profiles_: each pixel's predicted code at firstStep, firstStep + 1, ... (length steps) up its ray.
+    void sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length);
+    // Over the region's pixels, the predicted code at kLanes candidates from `candidate` on, blended from
+    // the profiles as blendOffsets_ and blendWeights_ say: its sum, its sum of squares and its sum of
+    // products with the residuals.
+    void accumulateBlends(std::size_t candidate, std::array<float, kLanes>& values,
+                          std::array<float, kLanes>& squares, std::array<float, kLanes>& products) const;
+    // Where an undistorted pixel's ray meets the table (mm), and the cosine of its angle from the vertical.
+    Eigen::Vector2d onTable(const Eigen::Vector2d& undistorted) const;
+    double verticalCosine(const Eigen::Vector2d& undistorted) const;
 
     HeightOptions options_;
     cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
     cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
     std::size_t heightCount_ = 0;
+    std::size_t slopeCount_ = 1;
+    // For a fingertip's pixels: how far behind the cap's centre along the finger (mm) and how far below
+    // the fingertip's top the surface they see lies (mm; along the view until the rays are known, then in
+    // height). Empty for other regions, which are searched flat.
+    struct FingertipShape {
+        float behindCapMm, belowTopMm;
+    };
+    std::vector<FingertipShape> shape_;
     // The geometry of the candidate planes: undistorted pixel -> ray (table frame), the camera's centre
     // (table frame), the projector's intrinsics times rotation, and the projector's image of the camera's
     // centre (homogeneous).
@@ -144,6 +180,9 @@ private:
     std::vector<cv::Point2f> points_;     // the region's undistorted pixels
     std::vector<float> residuals_;        // values_ less what their mean and a move explain
     PanelRays rays_;
+    std::vector<float> profiles_;
+    std::vector<std::size_t> blendOffsets_;  // per pixel: where its profile is read for candidate 0
+    std::vector<float> blendWeights_;        // per pixel: how far between two profile steps
 };
 
 }  // namespace everytouch::core

@@ -43,8 +43,6 @@ std::optional<std::string> DetectionOptions::validate() const {
         return "tracker." + *problem;
     if (!(fingerWidthMm > 0.0 && fingerWidthMm < 50.0))
         return "fingerWidthMm: must be in (0, 50) mm";
-    if (!(visibleAbovePadMm >= 0.0 && visibleAbovePadMm < 40.0))
-        return "visibleAbovePadMm: must be in [0, 40) mm";
     if (!(visibleSpreadMm >= 0.0 && visibleSpreadMm < 20.0))
         return "visibleSpreadMm: must be in [0, 20) mm";
     if (!(evidenceDecay >= 0.0 && evidenceDecay < 1.0))
@@ -198,7 +196,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         Remembered& memory = rememberedNext_[next++];
         memory.tip = tip.tip;
         memory.widthPx = tip.widthPx;
-        memory.evidence.clear(height_.heights());
+        memory.evidence.clear(height_.hypotheses());
         memory.evidence.add(frameEvidence_, 1.0);
         if (same >= 0 && nearest < kStillWidths * tip.widthPx)
             memory.evidence.add(remembered_[same].evidence, options_.evidenceDecay);
@@ -209,8 +207,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         // Without a height (the code on it not seen well enough) the pad is placed on the table: the
         // tracker uses it only for a finger that touches.
         if (observation.visible.valid)
-            observation.padHeightMm =
-                std::max(0.0, observation.visible.heightMm - options_.visibleAbovePadMm);
+            observation.padHeightMm = observation.visible.padHeightMm;
         // The contact point: the pad, seen through the plane of its height.
         const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
@@ -222,8 +219,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         // is too faint. A rising finger also stays put in the image, but its lift shows a height above the
         // touch height before its code fades, and the tracker then lifts it at once.
         if (!finger.heightKnown)
-            finger.codeFavoursTable =
-                height_.favoursUpTo(memory.evidence, settings.touchHeightMm + options_.visibleAbovePadMm);
+            finger.codeFavoursTable = height_.favoursPadUpTo(memory.evidence, settings.touchHeightMm);
         finger.padHeightMm = observation.padHeightMm;
         if (finger.heightKnown)
             finger.heightUncertaintyMm =

@@ -40,15 +40,10 @@ struct DetectionOptions {
     TrackerOptions tracker;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
     double fingerWidthMm = 16.0;
-    // How far above its pad the camera sees the back of a fingertip (mm), in the region the height is
-    // measured on (HeightOptions): fingertips are 12-15 mm thick and round and tilt up towards the hand, so
-    // the surface seen there lies about 11 mm up. The simulated hand measures 11-12.5 mm within 10 mm of the
-    // table (docs/detection.md). Each finger's own thickness is not learned yet.
-    double visibleAbovePadMm = 11.0;
-    // How much that height varies from frame to frame on a resting fingertip, one standard deviation (mm):
-    // the correlation's peak shifts as the surface under the region changes with the finger's pose. It adds
-    // to each frame's statistical uncertainty, so that the tracker's hysteresis and its decisive evidence
-    // see how far one frame's height can really be trusted.
+    // How much a fingertip's visible height varies from frame to frame on a resting fingertip, one standard
+    // deviation (mm): the correlation's peak shifts as the surface under the region changes with the finger's
+    // pose. It adds to each frame's statistical uncertainty, so that the tracker's hysteresis and its
+    // decisive evidence see how far one frame's height can really be trusted.
     double visibleSpreadMm = 2.0;
     // Evidence of earlier frames counts this much less each frame while a fingertip stays put (moves less
     // than a tenth of its width): a half-life of about two frames keeps a touch-down's latency at one frame.

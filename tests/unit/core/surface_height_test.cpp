@@ -60,11 +60,11 @@ TEST(SurfaceHeight, EvidenceWithoutAHeightStillLeansToTheSideOfItsBestMatch) {
     // Two peaks about as high give no height; the better one below 20 mm favours that side.
     const auto lowBetter = [](double h) { return peak(h, 8, 0.5) + peak(h, 30, 0.45); };
     ASSERT_FALSE(height.estimate(evidenceWith(200, lowBetter)).valid);
-    EXPECT_TRUE(height.favoursUpTo(evidenceWith(200, lowBetter), 20.0));
-    EXPECT_FALSE(height.favoursUpTo(
+    EXPECT_TRUE(height.favoursPadUpTo(evidenceWith(200, lowBetter), 20.0));
+    EXPECT_FALSE(height.favoursPadUpTo(
         evidenceWith(200, [](double h) { return peak(h, 8, 0.45) + peak(h, 30, 0.5); }), 20.0));
     // Nothing beyond chance (0.1 over 200 pixels): no side.
-    EXPECT_FALSE(height.favoursUpTo(evidenceWith(200, [](double h) { return peak(h, 8, 0.25); }), 20.0));
+    EXPECT_FALSE(height.favoursPadUpTo(evidenceWith(200, [](double h) { return peak(h, 8, 0.25); }), 20.0));
 }
 
 TEST(HeightOptions, MistakesAreNamed) {
