@@ -156,6 +156,7 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     gradients_.reserve(kTypicalMostPixels);
     residuals_.reserve(kTypicalMostPixels);
     rays_.reserve(kTypicalMostPixels);
+    shape_.reserve(kTypicalMostPixels);
     blendOffsets_.reserve(kTypicalMostPixels);
     blendWeights_.reserve(kTypicalMostPixels);
 
@@ -194,13 +195,17 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
     CV_Assert((plus.type() == CV_8UC1 || plus.type() == CV_8UC3) && minus.type() == plus.type() &&
               minus.size() == plus.size() && handMask.type() == CV_8UC1 && handMask.size() == plus.size());
     const bool colour = plus.channels() == 3;
+    clearPixels();
+    if (!(widthPx > 0.0)) {
+        evidence.clear(hypotheses());
+        return;
+    }
     const Eigen::Vector2d centre = tip - options_.centreBehindWidths * widthPx * direction;
     const double radius = options_.regionWidths * widthPx;
     const int x0 = std::max(1, static_cast<int>(std::floor(centre.x() - radius)));
     const int x1 = std::min(plus.cols - 2, static_cast<int>(std::ceil(centre.x() + radius)));
     const int y0 = std::max(1, static_cast<int>(std::floor(centre.y() - radius)));
     const int y1 = std::min(plus.rows - 2, static_cast<int>(std::ceil(centre.y() + radius)));
-    clearPixels();
     const auto undistortedAt = [&](const Eigen::Vector2d& p) {
         const cv::Vec2f& u =
             undistorted_.at<cv::Vec2f>(std::clamp(static_cast<int>(std::lround(p.y())), 0, plus.rows - 1),
