@@ -486,17 +486,16 @@ struct HeightProfile {
                 return true;
         return false;
     }
-    // The best correlation at height h and the slope it was found at; -2 without evidence.
-    std::pair<double, std::size_t> best(std::size_t h) const {
-        std::pair<double, std::size_t> result{-2.0, 0};
-        for (std::size_t at = h, s = 0; at < evidence.codeVariance.size(); at += heights, ++s) {
+    // The best correlation at height h over its slopes; -2 without evidence.
+    double correlation(std::size_t h) const {
+        double best = -2.0;
+        for (std::size_t at = h; at < evidence.codeVariance.size(); at += heights) {
             const double denominator = std::sqrt(evidence.codeVariance[at] * evidence.subtractionVariance);
-            if (denominator > 0.0 && evidence.covariance[at] / denominator > result.first)
-                result = {evidence.covariance[at] / denominator, s};
+            if (denominator > 0.0)
+                best = std::max(best, evidence.covariance[at] / denominator);
         }
-        return result;
+        return best;
     }
-    double correlation(std::size_t h) const { return best(h).first; }
 };
 
 }  // namespace
@@ -522,13 +521,12 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
         evidence.subtractionVariance <= 0.0)
         return result;
     const HeightProfile profile{evidence, count};
-    std::size_t best = 0, bestSlope = 0;
+    std::size_t best = 0;
     double bestCorrelation = -2.0;
     for (std::size_t h = 0; h < count; ++h)
-        if (const auto [r, slope] = profile.best(h); r > bestCorrelation) {
+        if (const double r = profile.correlation(h); r > bestCorrelation) {
             bestCorrelation = r;
             best = h;
-            bestSlope = slope;
         }
     // Chance correlation over the region: neighbouring pixels share light through the blurs, about two
     // pixels per independent sample.
@@ -573,7 +571,6 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
     result.valid = true;
     result.heightMm = (static_cast<double>(best) + offset) * options_.stepMm;
     result.padHeightMm = std::max(0.0, result.heightMm - evidence.topAbovePadTimesPixels / evidence.pixels);
-    result.slope = evidence.covariance.size() > count ? slopeOf(bestSlope) : 0.0;
     // The peak's width in height over its height above chance: a sharp, strong peak pins the height down.
     result.uncertaintyMm = options_.stepMm * chance / std::max(bestCorrelation, chance) * 4.0;
     return result;

@@ -88,7 +88,6 @@ struct HeightEstimate {
     double padHeightMm = 0.0;    // of its lowest point, by the fingertip's shape; heightMm otherwise
     double correlation = 0.0;    // at that height
     double uncertaintyMm = 0.0;  // one standard deviation
-    double slope = 0.0;          // the surface's rise towards the hand, mm per mm
 };
 
 class BilinearSampler;
