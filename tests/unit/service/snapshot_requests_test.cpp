@@ -217,7 +217,7 @@ SnapshotRenderer noiseRenderer() {
 TEST_F(SnapshotRequestsTest, AReaderThatNeverReadsHoldsUpNothingButItsOwnCall) {
     io::ReplaySource source(dir_ / "recording", false);
     FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
-    SnapshotRequests requests(event_.get(), loop, inbox_, noiseRenderer(), SnapshotTimeouts{3000ms, 300ms});
+    SnapshotRequests requests(event_.get(), loop, inbox_, noiseRenderer(), SnapshotTimeouts{3000ms, 1000ms});
     int ends[2];
     ASSERT_EQ(::pipe2(ends, O_CLOEXEC), 0);
     const io::UniqueFd readEnd(ends[0]);
@@ -226,7 +226,9 @@ TEST_F(SnapshotRequestsTest, AReaderThatNeverReadsHoldsUpNothingButItsOwnCall) {
     requests.add(SnapshotKind::Camera, writeEnd.get(), answers.reply());
 
     loop.start();
-    // Every turn of the main loop stays short while the PNG waits for its reader.
+    // Every turn of the main loop stays short while the PNG waits for its reader: a turn that waited for it
+    // would last the write timeout. Encoding the noise's PNG, which a turn does, took up to 157 ms under
+    // AddressSanitizer on a loaded machine.
     Clock::duration longestTurn{};
     const auto deadline = Clock::now() + 30s;
     while (answers.done + answers.failures.size() == 0 && Clock::now() < deadline) {
@@ -234,11 +236,11 @@ TEST_F(SnapshotRequestsTest, AReaderThatNeverReadsHoldsUpNothingButItsOwnCall) {
         ASSERT_GE(sd_event_run(event_.get(), 20'000), 0);
         longestTurn = std::max(longestTurn, Clock::now() - begun);
     }
-    EXPECT_LT(longestTurn, 150ms);
+    EXPECT_LT(longestTurn, 500ms);
     EXPECT_EQ(answers.done, 0);
     ASSERT_EQ(answers.failures.size(), 1u);
     EXPECT_EQ(answers.failures.front().first, SD_BUS_ERROR_IO_ERROR);
-    EXPECT_EQ(answers.failures.front().second, "The reader did not take the PNG within 0.3 s");
+    EXPECT_EQ(answers.failures.front().second, "The reader did not take the PNG within 1 s");
     EXPECT_EQ(requests.pending(), 0u);
 }
 
