@@ -144,8 +144,13 @@ private:
     void addValue(float value, int x, int y);
     // residuals_: values_ less their mean and, when gradients_ were gathered, what the gradients explain.
     void fitResiduals();
-    // profiles_: each pixel's predicted code at firstStep, firstStep + 1, ... (length steps) up its ray.
-    void sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length);
+    // How many candidate steps apart a ray's profile from firstStep over `length` steps may be sampled so
+    // that the panel moves at most profileSpacingPx_ between two samples.
+    std::size_t profileSpacingSteps(int firstStep, std::size_t length) const;
+    // profiles_: each pixel's predicted code at firstStep, firstStep + 1, ... (length steps) up its ray,
+    // sampled every `spacing` steps and interpolated between.
+    void sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length,
+                        std::size_t spacing);
     // Over the region's pixels, the predicted code at kLanes candidates from `candidate` on, blended from
     // the profiles as blendOffsets_ and blendWeights_ say: its sum, its sum of squares and its sum of
     // products with the residuals.
@@ -156,7 +161,8 @@ private:
     double verticalCosine(const Eigen::Vector2d& undistorted) const;
 
     HeightOptions options_;
-    cv::Mat panel_;        // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
+    cv::Mat panel_;  // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
+    double profileSpacingPx_ = 0.5;
     cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
     std::size_t heightCount_ = 0;
     std::size_t slopeCount_ = 1;
