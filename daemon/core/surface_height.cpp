@@ -316,11 +316,9 @@ void SurfaceHeight::measurePixels(HeightEvidence& evidence, std::size_t stride) 
         }
     const std::size_t padded = (candidates + kLanes - 1) / kLanes * kLanes;
     const int firstStep = static_cast<int>(std::floor(lowest));
-    const std::size_t reach =
-        static_cast<std::size_t>(static_cast<int>(std::floor(highest)) - firstStep) + padded;
-    const std::size_t spacing = profileSpacingSteps(firstStep, reach);
-    const std::size_t length = (reach + spacing - 1) / spacing * spacing + 1;
-    sampleProfiles(BilinearSampler(panel_), firstStep, length, spacing);
+    const std::size_t length =
+        static_cast<std::size_t>(static_cast<int>(std::floor(highest)) - firstStep) + padded + 1;
+    sampleProfiles(BilinearSampler(panel_), firstStep, length, profileSpacingSteps(firstStep, length));
     blendOffsets_.resize(n);
     blendWeights_.resize(n);
     for (std::size_t slope = 0; slope < slopes; ++slope) {
@@ -386,16 +384,20 @@ std::size_t SurfaceHeight::profileSpacingSteps(int firstStep, std::size_t length
             const float moveY = rays_.stepY[i] * z - y * rays_.stepZ[i];
             fastest = std::max(fastest, std::hypot(moveX, moveY) / (z * z));
         }
-    if (!(fastest > 0.0f))
-        return 1;
-    return static_cast<std::size_t>(std::clamp(std::floor(profileSpacingPx_ / fastest), 1.0, 8.0));
+    if (!(fastest > 0.0f) || profileSpacingPx_ / fastest >= static_cast<float>(length))
+        return length;
+    return std::max<std::size_t>(1, static_cast<std::size_t>(profileSpacingPx_ / fastest));
 }
 
 void SurfaceHeight::sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length,
                                    std::size_t spacing) {
     const std::size_t n = residuals_.size();
     profiles_.resize(n * length);
-    for (std::size_t j = 0; j < length; j += spacing) {
+    // Every `spacing` steps and the last one.
+    const auto nextSample = [&](std::size_t j) {
+        return j + 1 == length ? length : std::min(j + spacing, length - 1);
+    };
+    for (std::size_t j = 0; j < length; j = nextSample(j)) {
         const float steps = static_cast<float>(firstStep + static_cast<int>(j));
         std::size_t i = 0;
 #if CV_SIMD128
@@ -447,13 +449,12 @@ void SurfaceHeight::sampleProfiles(const BilinearSampler& sample, int firstStep,
     }
     if (spacing == 1)
         return;
-    // Between the samples, along each ray, the straight line: length - 1 is a multiple of the spacing.
-    const float inverseSpacing = 1.0f / static_cast<float>(spacing);
+    // Between the samples, along each ray, the straight line.
     for (std::size_t i = 0; i < n; ++i) {
         float* profile = profiles_.data() + i * length;
-        for (std::size_t j = 0; j + spacing < length; j += spacing) {
-            const float from = profile[j], slope = (profile[j + spacing] - from) * inverseSpacing;
-            for (std::size_t t = 1; t < spacing; ++t)
+        for (std::size_t j = 0, to = nextSample(0); to < length; j = to, to = nextSample(to)) {
+            const float from = profile[j], slope = (profile[to] - from) / static_cast<float>(to - j);
+            for (std::size_t t = 1; j + t < to; ++t)
                 profile[j + t] = from + slope * static_cast<float>(t);
         }
     }

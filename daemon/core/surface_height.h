@@ -148,7 +148,7 @@ private:
     // that the panel moves at most profileSpacingPx_ between two samples.
     std::size_t profileSpacingSteps(int firstStep, std::size_t length) const;
     // profiles_: each pixel's predicted code at firstStep, firstStep + 1, ... (length steps) up its ray,
-    // sampled every `spacing` steps and interpolated between.
+    // sampled every `spacing` steps and at the last, and interpolated between.
     void sampleProfiles(const BilinearSampler& sample, int firstStep, std::size_t length,
                         std::size_t spacing);
     // Over the region's pixels, the predicted code at kLanes candidates from `candidate` on, blended from
@@ -161,9 +161,9 @@ private:
     double verticalCosine(const Eigen::Vector2d& undistorted) const;
 
     HeightOptions options_;
-    cv::Mat panel_;  // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
-    double profileSpacingPx_ = 0.5;
-    cv::Mat undistorted_;  // CV_32FC2, camera size: each raw pixel's undistorted position
+    cv::Mat panel_;                  // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
+    double profileSpacingPx_ = 1.0;  // how far the panel may move between two samples of a ray's profile
+    cv::Mat undistorted_;            // CV_32FC2, camera size: each raw pixel's undistorted position
     std::size_t heightCount_ = 0;
     std::size_t slopeCount_ = 1;
     // For a fingertip's pixels: how far behind the cap's centre along the finger (mm) and how far below
