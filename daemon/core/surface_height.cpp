@@ -113,6 +113,17 @@ void HeightEvidence::add(const HeightEvidence& other, double weight) {
     topAbovePadTimesPixels += weight * other.topAbovePadTimesPixels;
 }
 
+void SlopeSupport::clear(std::size_t slopes) {
+    logLikelihood.assign(slopes, 0.0);
+}
+
+void SlopeSupport::add(const SlopeSupport& other, double weight) {
+    if (logLikelihood.size() != other.logLikelihood.size())
+        clear(other.logLikelihood.size());
+    for (std::size_t i = 0; i < logLikelihood.size(); ++i)
+        logLikelihood[i] += weight * other.logLikelihood[i];
+}
+
 SurfaceHeight::SurfaceHeight(const HeightOptions& options) : options_(options) {
     if (auto problem = options.validate())
         throw std::invalid_argument("height options: " + *problem);
@@ -511,36 +522,70 @@ void SurfaceHeight::fitResiduals() {
 
 namespace {
 
-// The evidence's correlation at each candidate height, the best over its slopes.
-struct HeightProfile {
-    const HeightEvidence& evidence;
-    std::size_t heights;
+// The evidence's correlation at each candidate height: at a given slope, interpolated between the two
+// candidate slopes around it, or the best over its slopes.
+class HeightProfile {
+public:
+    // slopeStep: between candidate slopes; slope: in the same unit, or nothing for the best.
+    HeightProfile(const HeightEvidence& evidence, std::size_t heights, double slopeStep,
+                  std::optional<double> slope)
+        : evidence_(evidence), heights_(heights), rows_(evidence.codeVariance.size() / heights) {
+        if (!slope || rows_ < 2)
+            return;
+        const double position = std::clamp(*slope / slopeStep, 0.0, static_cast<double>(rows_ - 1));
+        row_ = std::min(static_cast<std::size_t>(position), rows_ - 2);
+        weight_ = position - static_cast<double>(row_);
+        atSlope_ = true;
+    }
 
     bool measured(std::size_t h) const {
-        for (std::size_t at = h; at < evidence.codeVariance.size(); at += heights)
-            if (evidence.codeVariance[at] > 0.0)
+        if (atSlope_)
+            return rowCorrelation(row_, h) || rowCorrelation(row_ + 1, h);
+        for (std::size_t row = 0; row < rows_; ++row)
+            if (rowCorrelation(row, h))
                 return true;
         return false;
     }
-    // The best correlation at height h over its slopes; -2 without evidence.
+    // -2 without evidence.
     double correlation(std::size_t h) const {
-        double best = -2.0;
-        for (std::size_t at = h; at < evidence.codeVariance.size(); at += heights) {
-            const double denominator = std::sqrt(evidence.codeVariance[at] * evidence.subtractionVariance);
-            if (denominator > 0.0)
-                best = std::max(best, evidence.covariance[at] / denominator);
+        if (atSlope_) {
+            const std::optional<double> low = rowCorrelation(row_, h), high = rowCorrelation(row_ + 1, h);
+            if (low && high)
+                return (1.0 - weight_) * *low + weight_ * *high;
+            return low ? *low : high ? *high : -2.0;
         }
+        double best = -2.0;
+        for (std::size_t row = 0; row < rows_; ++row)
+            if (const std::optional<double> r = rowCorrelation(row, h))
+                best = std::max(best, *r);
         return best;
     }
+
+private:
+    std::optional<double> rowCorrelation(std::size_t row, std::size_t h) const {
+        const std::size_t at = row * heights_ + h;
+        const double denominator = std::sqrt(evidence_.codeVariance[at] * evidence_.subtractionVariance);
+        if (!(denominator > 0.0))
+            return std::nullopt;
+        return evidence_.covariance[at] / denominator;
+    }
+
+    const HeightEvidence& evidence_;
+    std::size_t heights_;
+    std::size_t rows_;
+    bool atSlope_ = false;
+    std::size_t row_ = 0;
+    double weight_ = 0.0;
 };
 
 }  // namespace
 
-bool SurfaceHeight::favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm) const {
+bool SurfaceHeight::favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm,
+                                   std::optional<double> slope) const {
     if (evidence.covariance.size() < heightCount_ || evidence.pixels < 8 ||
         evidence.subtractionVariance <= 0.0)
         return false;
-    const HeightProfile profile{evidence, heightCount_};
+    const HeightProfile profile(evidence, heightCount_, options_.slopeStep, slope);
     const double heightMm = padHeightMm + evidence.topAbovePadTimesPixels / evidence.pixels;
     double below = -2.0, above = -2.0;
     for (std::size_t h = 0; h < heightCount_; ++h) {
@@ -550,13 +595,42 @@ bool SurfaceHeight::favoursPadUpTo(const HeightEvidence& evidence, double padHei
     return below > above && below >= options_.significance * std::sqrt(2.0 / evidence.pixels);
 }
 
-HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence) const {
+void SurfaceHeight::supportSlopes(const HeightEvidence& evidence, SlopeSupport& support) const {
+    const std::size_t rows = heightCount_ == 0 ? 0 : evidence.codeVariance.size() / heightCount_;
+    support.clear(rows);
+    if (evidence.pixels < 8 || evidence.subtractionVariance <= 0.0)
+        return;
+    for (std::size_t row = 0; row < rows; ++row) {
+        const HeightProfile profile(evidence, heightCount_, options_.slopeStep,
+                                    static_cast<double>(row) * options_.slopeStep);
+        double best = 0.0;
+        for (std::size_t h = 0; h < heightCount_; ++h)
+            best = std::max(best, profile.correlation(h));
+        support.logLikelihood[row] = 0.25 * evidence.pixels * best * best;
+    }
+}
+
+double SurfaceHeight::bestSlope(const SlopeSupport& support) const {
+    const std::vector<double>& l = support.logLikelihood;
+    if (l.empty())
+        return 0.0;
+    const std::size_t best = static_cast<std::size_t>(std::max_element(l.begin(), l.end()) - l.begin());
+    double offset = 0.0;
+    if (best > 0 && best + 1 < l.size()) {
+        const double curvature = l[best - 1] - 2.0 * l[best] + l[best + 1];
+        if (curvature < 0.0)
+            offset = std::clamp(0.5 * (l[best - 1] - l[best + 1]) / curvature, -0.5, 0.5);
+    }
+    return (static_cast<double>(best) + offset) * options_.slopeStep;
+}
+
+HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence, std::optional<double> slope) const {
     HeightEstimate result;
     const std::size_t count = heightCount_;
     if (count == 0 || evidence.covariance.size() < count || evidence.pixels < 8 ||
         evidence.subtractionVariance <= 0.0)
         return result;
-    const HeightProfile profile{evidence, count};
+    const HeightProfile profile(evidence, count, options_.slopeStep, slope);
     std::size_t best = 0;
     double bestCorrelation = -2.0;
     for (std::size_t h = 0; h < count; ++h)

@@ -80,6 +80,18 @@ struct HeightEvidence {
     void add(const HeightEvidence& other, double weight);
 };
 
+// How well each slope of a fingertip's shape explains its code, summed over the frames of its track: the
+// log-likelihood of the slope's best height (chance correlations over n pixels having a variance of 2 / n).
+// A finger's pitch changes slowly, while one frame's faint code trades slope for height by chance: searched
+// frame by frame, the slope's choice alone moved a hovering fingertip's height by 2 mm from one frame to the
+// next (docs/detection.md).
+struct SlopeSupport {
+    std::vector<double> logLikelihood;  // per slope
+
+    void clear(std::size_t slopes);
+    void add(const SlopeSupport& other, double weight);
+};
+
 struct HeightEstimate {
     // The code was seen on the fingertip well enough to tell a height, its best height lies below the top
     // of the range, and no other height comes near it.
@@ -122,11 +134,20 @@ public:
     // the table from something well above it.
     void measurePixels(HeightEvidence& evidence, std::size_t stride = 1);
 
-    // The height the evidence supports best.
-    HeightEstimate estimate(const HeightEvidence& evidence) const;
+    // Candidate slopes in a fingertip's evidence (1 for a region searched flat).
+    std::size_t slopes() const { return slopeCount_; }
+    // What one frame's evidence says of each slope.
+    void supportSlopes(const HeightEvidence& evidence, SlopeSupport& support) const;
+    // The slope the support favours, between the candidates; 0 without support.
+    double bestSlope(const SlopeSupport& support) const;
+
+    // The height the evidence supports best: at `slope` (interpolated between the two nearest candidates)
+    // when given, otherwise at whichever slope fits best.
+    HeightEstimate estimate(const HeightEvidence& evidence, std::optional<double> slope = std::nullopt) const;
     // Whether evidence that gives no height (its peak not distinct, or at the top of the range) still leans:
     // its best match among the pad heights up to `padHeightMm` is significant and beats every one above.
-    bool favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm) const;
+    bool favoursPadUpTo(const HeightEvidence& evidence, double padHeightMm,
+                        std::optional<double> slope = std::nullopt) const;
 
 private:
     // Where the projector sees each pixel's ray: on the table and a step up to the next candidate height

@@ -47,6 +47,8 @@ std::optional<std::string> DetectionOptions::validate() const {
         return "visibleSpreadMm: must be in [0, 20) mm";
     if (!(evidenceDecay >= 0.0 && evidenceDecay < 1.0))
         return "evidenceDecay: must be in [0, 1)";
+    if (!(slopeMemoryS >= 0.0 && slopeMemoryS <= 60.0))
+        return "slopeMemoryS: must be in [0, 60] s";
     return std::nullopt;
 }
 
@@ -196,14 +198,23 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         Remembered& memory = rememberedNext_[next++];
         memory.tip = tip.tip;
         memory.widthPx = tip.widthPx;
+        memory.timestampUs = result_.timestampUs;
         memory.evidence.clear(height_.hypotheses());
         memory.evidence.add(frameEvidence_, 1.0);
         if (same >= 0 && nearest < kStillWidths * tip.widthPx)
             memory.evidence.add(remembered_[same].evidence, options_.evidenceDecay);
+        height_.supportSlopes(frameEvidence_, memory.slopes);
+        if (same >= 0 && options_.slopeMemoryS > 0.0) {
+            const double sinceS =
+                static_cast<double>(result_.timestampUs - remembered_[same].timestampUs) * 1e-6;
+            memory.slopes.add(remembered_[same].slopes,
+                              std::exp(-std::max(0.0, sinceS) / options_.slopeMemoryS));
+        }
+        const double slope = height_.bestSlope(memory.slopes);
 
         FingertipObservation& observation = result_.fingertips.emplace_back();
         observation.fingertip = tip;
-        observation.visible = height_.estimate(memory.evidence);
+        observation.visible = height_.estimate(memory.evidence, slope);
         // Without a height (the code on it not seen well enough) the pad is placed on the table: the
         // tracker uses it only for a finger that touches.
         if (observation.visible.valid)
@@ -219,7 +230,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         // is too faint. A rising finger also stays put in the image, but its lift shows a height above the
         // touch height before its code fades, and the tracker then lifts it at once.
         if (!finger.heightKnown)
-            finger.codeFavoursTable = height_.favoursPadUpTo(memory.evidence, settings.touchHeightMm);
+            finger.codeFavoursTable = height_.favoursPadUpTo(memory.evidence, settings.touchHeightMm, slope);
         finger.padHeightMm = observation.padHeightMm;
         if (finger.heightKnown)
             finger.heightUncertaintyMm =

@@ -48,6 +48,10 @@ struct DetectionOptions {
     // Evidence of earlier frames counts this much less each frame while a fingertip stays put (moves less
     // than a tenth of its width): a half-life of about two frames keeps a touch-down's latency at one frame.
     double evidenceDecay = 0.7;
+    // How long a fingertip's slope (its finger's pitch) remembers the evidence of earlier frames, s: the
+    // support of a frame that long ago counts 1/e as much as this frame's, whether or not the finger moved.
+    // Hands change their pitch over a tap or a slide, not from one frame to the next.
+    double slopeMemoryS = 0.4;
 
     std::optional<std::string> validate() const;
 };
@@ -108,7 +112,9 @@ private:
     struct Remembered {
         Eigen::Vector2d tip = Eigen::Vector2d::Zero();
         double widthPx = 0.0;
+        std::int64_t timestampUs = 0;
         HeightEvidence evidence;
+        SlopeSupport slopes;
     };
 
     void adoptRig(const PipelineSettings& settings);
@@ -132,6 +138,7 @@ private:
     cv::Mat rigPattern_;
     double displayPixelsPerMm_ = 1.0;
     HeightEvidence frameEvidence_;
+    SlopeSupport frameSlopes_;
     // Fixed capacity (the most fingertips), so that remembering allocates nothing; counts say what is used.
     std::vector<Remembered> remembered_;
     std::vector<Remembered> rememberedNext_;

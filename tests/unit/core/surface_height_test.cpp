@@ -1,6 +1,7 @@
 // The height a correlation curve supports, from the evidence alone.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "core/surface_height.h"
@@ -65,6 +66,66 @@ TEST(SurfaceHeight, EvidenceWithoutAHeightStillLeansToTheSideOfItsBestMatch) {
         evidenceWith(200, [](double h) { return peak(h, 8, 0.45) + peak(h, 30, 0.5); }), 20.0));
     // Nothing beyond chance (0.1 over 200 pixels): no side.
     EXPECT_FALSE(height.favoursPadUpTo(evidenceWith(200, [](double h) { return peak(h, 8, 0.25); }), 20.0));
+}
+
+// Evidence over five slopes (0, 0.5, ... 2 mm per mm, the default candidates) whose correlation at slope
+// row k and height h is curve(k, h).
+template <typename Curve>
+HeightEvidence slopedEvidenceWith(double pixels, Curve curve) {
+    HeightEvidence evidence;
+    evidence.clear(5 * 49);
+    evidence.pixels = pixels;
+    evidence.subtractionVariance = 1.0;
+    for (std::size_t k = 0; k < 5; ++k)
+        for (std::size_t h = 0; h < 49; ++h) {
+            evidence.codeVariance[k * 49 + h] = 1.0;
+            evidence.covariance[k * 49 + h] = curve(static_cast<double>(k), static_cast<double>(h));
+        }
+    return evidence;
+}
+
+TEST(SurfaceHeight, AtAGivenSlopeTheHeightIsReadBetweenTheTwoNearestSlopes) {
+    // As on a fingertip: a steeper finger fits the same code with its cap lower, 4 mm per slope step.
+    const SurfaceHeight height{HeightOptions{}};
+    const auto ridge = [](double k, double h) { return peak(h, 20.0 - 4.0 * k, 0.5 - 0.01 * k); };
+    const HeightEvidence evidence = slopedEvidenceWith(400, ridge);
+    const HeightEstimate best = height.estimate(evidence);
+    ASSERT_TRUE(best.valid);
+    EXPECT_NEAR(best.heightMm, 20.0, 0.2);  // the best correlation: slope 0
+    const HeightEstimate between = height.estimate(evidence, 0.75);
+    ASSERT_TRUE(between.valid);
+    EXPECT_NEAR(between.heightMm, 14.0, 0.5);  // halfway between slope 0.5 (16 mm) and 1.0 (12 mm)
+    const HeightEstimate steepest = height.estimate(evidence, 5.0);  // beyond the candidates: the last
+    ASSERT_TRUE(steepest.valid);
+    EXPECT_NEAR(steepest.heightMm, 4.0, 0.2);
+}
+
+TEST(SurfaceHeight, SlopeSupportAddsUpOverFramesAndNamesTheSlopeBetweenCandidates) {
+    const SurfaceHeight height{HeightOptions{}};
+    ASSERT_EQ(height.slopes(), 5u);
+    // One frame fits slope 1.0 best by chance; five others fit slopes 0.5 and 1.0 about equally, 0.5 a
+    // little better.
+    const auto frameAt = [&](std::array<double, 5> best) {
+        SlopeSupport support;
+        height.supportSlopes(slopedEvidenceWith(400,
+                                                [&](double k, double h) {
+                                                    return peak(h, 20.0 - 4.0 * k,
+                                                                best[static_cast<std::size_t>(k)]);
+                                                }),
+                             support);
+        return support;
+    };
+    const SlopeSupport chance = frameAt({0.30, 0.40, 0.50, 0.30, 0.20});
+    EXPECT_NEAR(height.bestSlope(chance), 1.0, 0.25);
+    // The log-likelihood of the slope's best height: pixels / 4 times its correlation squared.
+    EXPECT_NEAR(chance.logLikelihood[2], 0.25 * 400 * 0.25, 1e-9);
+    SlopeSupport track = chance;
+    for (int frame = 0; frame < 5; ++frame)
+        track.add(frameAt({0.30, 0.50, 0.45, 0.30, 0.20}), 1.0);
+    const double slope = height.bestSlope(track);
+    EXPECT_GT(slope, 0.5);
+    EXPECT_LT(slope, 0.75);
+    EXPECT_EQ(height.bestSlope(SlopeSupport{}), 0.0);
 }
 
 TEST(HeightOptions, MistakesAreNamed) {
