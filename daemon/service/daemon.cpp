@@ -668,6 +668,10 @@ void Daemon::shutDown() {
         if (exitStatus_ == kExitSuccess)
             exitStatus_ = kExitFailure;
     }
+    if (statistics.recordingDropped != 0)
+        // A live camera does not wait for the disk: the recording has gaps, which a replay pairs across.
+        ET_LOG(Warning) << options_.recordDir.string() << " leaves out " << statistics.recordingDropped
+                        << " frames that came while the disk was still writing earlier ones";
     snapshots_.reset();
     loop_.reset();
 }

@@ -45,9 +45,9 @@ FrameLoop::FrameLoop(io::FrameSource& source, core::PairPipeline& pipeline, std:
       notify_(std::move(notify)),
       onSettings_(std::move(onSettings)),
       queue_(options.queueCapacity, options.overflow),
-      // Every frame that can be held at once: those queued, the one paired with the next, and one being
-      // filled.
-      spareFrames_(options.queueCapacity + 2),
+      // Every frame that can be held at once: those queued, the one paired with the next, one being filled,
+      // and those waiting to be recorded.
+      spareFrames_(options.queueCapacity + 2 + (recorder ? options.recordingCapacity + 1 : 0)),
       settings_(std::move(settings)),
       pipelineMs_(kPipelineSamples, 0.0) {}
 
@@ -61,6 +61,9 @@ void FrameLoop::start() {
         started_ = Clock::now();
     }
     heartbeatNs_ = Clock::now().time_since_epoch().count();
+    if (recorder_)
+        recording_.emplace(*recorder_, options_.recordingCapacity, options_.overflow, spareFrames_,
+                           [this](const std::string& problem) { stopRecording(problem); });
     pipelineThread_ = std::thread([this] {
         io::nameThisThread("et-pipeline");
         runPipeline();
@@ -80,6 +83,8 @@ void FrameLoop::stop() {
     queue_.close();
     if (camera_.joinable())
         camera_.join();
+    if (recording_)
+        recording_->finish();
     if (pipelineThread_.joinable())
         pipelineThread_.join();
 }
@@ -153,6 +158,8 @@ LoopStatistics FrameLoop::statistics() const {
         statistics.pipelineP99Ms = at(0.99);
     }
     statistics.dropped = queue_.dropped() + source_.droppedFrames();
+    if (recording_)
+        statistics.recordingDropped = recording_->dropped();
     statistics.frameRate = arrivals_.perSecond(Clock::now());
     if (!finished_)
         statistics.seconds = std::chrono::duration<double>(Clock::now() - started_).count();
@@ -210,28 +217,14 @@ void FrameLoop::runCamera() {
         if (!queue_.push(std::move(item)))
             break;
     }
-    if (recorder_ && !recorder_->stopped()) {
-        try {
-            recorder_->flush();
-        } catch (const std::exception& error) {
-            stopRecording(error.what());
-        }
-    }
+    if (recording_)
+        recording_->finish();
     queue_.close();
 }
 
 void FrameLoop::record(const core::Frame& frame) {
-    if (!recorder_ || recorder_->stopped())
-        return;
-    try {
-        recorder_->addFrame(frame);
-        if (const auto truth = source_.truth())
-            recorder_->addTruth(*truth);
-        if (const auto mask = source_.truthMask())
-            recorder_->addMask(frame.index, *mask);
-    } catch (const std::exception& error) {
-        stopRecording(error.what());
-    }
+    if (recording_)
+        recording_->add(frame, source_.truth(), source_.truthMask());
 }
 
 void FrameLoop::stopRecording(const std::string& problem) {

@@ -22,6 +22,7 @@
 #include "service/frame_pool.h"
 #include "service/frame_queue.h"
 #include "service/frame_tap.h"
+#include "service/recording_thread.h"
 
 namespace everytouch::service {
 
@@ -42,12 +43,17 @@ struct LoopStatistics {
     std::uint64_t polaritySwaps = 0;
     // Why the recording stopped before the stream did (a full disk), with what it kept; empty otherwise.
     std::string recordingStopped;
+    // Frames left out of the recording because writing fell behind the camera (service/recording_thread.h).
+    std::uint64_t recordingDropped = 0;
 };
 
 struct LoopOptions {
     std::uint64_t maxFrames = 0;                                       // stop after N camera frames; 0: never
     std::size_t queueCapacity = 4;                                     // frames waiting between the threads
     FrameQueue::Overflow overflow = FrameQueue::Overflow::DropOldest;  // Block for sources that can wait
+    // Frames waiting to be written to the recording: a live camera's burst of 67 ms at 120 Hz while the disk
+    // is busy.
+    std::size_t recordingCapacity = 8;
     // A live camera that delivers no frame for this long has stalled: every contact is released and detection
     // waits for frames. Nothing for sources that can wait (a replay or simulation run fast).
     std::optional<std::chrono::milliseconds> stallAfter;
@@ -112,8 +118,9 @@ private:
     // contact.
     void stalled(std::chrono::steady_clock::duration silence);
     void recordPipelineTime(double ms);
-    // Adds a frame to the recording; a write that fails stops the recording, never the detection.
+    // Hands a frame to the recording thread; a write that fails stops the recording, never the detection.
     void record(const core::Frame& frame);
+    // On the recording thread.
     void stopRecording(const std::string& problem);
     void fail(const std::string& problem);
     // The camera thread's side of a lost camera: says so once, has the contacts released, and waits
@@ -130,6 +137,7 @@ private:
     SettingsHook onSettings_;
     FrameQueue queue_;
     FramePool spareFrames_;  // images the pipeline thread is done with, for the camera thread to fill again
+    std::optional<RecordingThread> recording_;  // with a recorder, from start() on
     FrameTap tap_;
     core::FramePairer pairer_;  // pipeline thread only
 

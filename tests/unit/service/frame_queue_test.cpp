@@ -22,7 +22,7 @@ TEST(FrameQueue, DropsTheOldestFrameWhenFullAndCountsIt) {
     EXPECT_EQ(queue.dropped(), 2u);
     QueuedFrame item;
     for (std::uint64_t expected : {2u, 3u, 4u}) {
-        ASSERT_EQ(queue.pop(item, 0ms), FrameQueue::PopResult::Frame);
+        ASSERT_EQ(queue.pop(item, 0ms), FrameQueue::PopResult::Item);
         EXPECT_EQ(item.frame.index, expected);
     }
     EXPECT_EQ(queue.pop(item, 10ms), FrameQueue::PopResult::Timeout);
@@ -37,7 +37,7 @@ TEST(FrameQueue, BlockingProducerWaitsForTheConsumerAndLosesNothing) {
     });
     QueuedFrame item;
     std::uint64_t expected = 0;
-    while (queue.pop(item, 5s) == FrameQueue::PopResult::Frame)
+    while (queue.pop(item, 5s) == FrameQueue::PopResult::Item)
         EXPECT_EQ(item.frame.index, expected++);
     producer.join();
     EXPECT_EQ(expected, 50u);
@@ -50,7 +50,7 @@ TEST(FrameQueue, CloseDeliversWhatIsQueuedThenReportsClosed) {
     queue.close();
     EXPECT_FALSE(queue.push(frameNumber(8)));
     QueuedFrame item;
-    ASSERT_EQ(queue.pop(item, 0ms), FrameQueue::PopResult::Frame);
+    ASSERT_EQ(queue.pop(item, 0ms), FrameQueue::PopResult::Item);
     EXPECT_EQ(item.frame.index, 7u);
     EXPECT_EQ(queue.pop(item, 1s), FrameQueue::PopResult::Closed);
 }
