@@ -75,7 +75,8 @@ struct PipelineResult {
     cv::Mat texture;         // T, the frames' type
     cv::Mat handMask;        // CV_8UC1, 255 on the hand; all 0 when not detecting
     // The scene, with no fingertip in it, matched the last segmented pair within the camera's noise
-    // (core/still_scene.h): the mask is that pair's. Tracking ran on this pair.
+    // (core/still_scene.h), segmented less than 0.1 s before: the mask is that pair's. Tracking ran on this
+    // pair.
     bool sceneStill = false;
     // The pair's frames were taken the other way round than they came labelled: the code's sign says which
     // shows O + P (core/polarity_lock.h). S, the height and everything after follow that order.
@@ -130,6 +131,7 @@ private:
     bool codeBlurMeasured_ = false;
     int pairsUntilBlurMeasure_ = 0;
     StillScene stillScene_;
+    std::int64_t segmentedUs_ = 0;  // the timestamp of the last pair segmented
     SurfaceHeight height_;
     ContactTracker tracker_;
     FingertipScratch fingertipScratch_;

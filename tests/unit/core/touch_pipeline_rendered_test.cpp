@@ -94,6 +94,7 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     Frame older, newer;
     sim::FrameTruth truth;
     int emptyPairs = 0, stillEmptyPairs = 0, handPairs = 0, stillHandPairs = 0;
+    int stillRun = 0, longestStillRun = 0;
     int segmentedHandPixels = -1;  // what the truth showed of the hand at the last pair segmented
     simulator.render(0, older, truth);
     for (std::uint64_t index = 1; index < 160; ++index) {
@@ -108,6 +109,8 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
             ++handPairs;
             stillHandPairs += result.sceneStill ? 1 : 0;
         }
+        stillRun = result.sceneStill ? stillRun + 1 : 0;
+        longestStillRun = std::max(longestStillRun, stillRun);
         if (!result.sceneStill)
             segmentedHandPixels = handPixels;
         else
@@ -120,6 +123,10 @@ TEST(TouchPipelineRendered, OnlyAStillSceneKeepsItsMask) {
     // were still); a hand that moves in keeps every pair changed but for its pauses (2 of 83).
     EXPECT_GE(stillEmptyPairs, emptyPairs / 2);
     EXPECT_LE(stillHandPairs, handPairs / 10);
+    // A mask is kept for at most 0.1 s, 12 pairs at 120 Hz: a segmentation that lost a hand holding still
+    // is taken again by then.
+    EXPECT_GT(longestStillRun, 6);
+    EXPECT_LE(longestStillRun, 12);
 }
 
 TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
