@@ -27,8 +27,8 @@ bool sameCalibration(const Calibration& a, const Calibration& b) {
 constexpr double kStillWidths = 0.1;
 // A fingertip of this frame is the one of the last frame when it lies within this fraction of its width.
 constexpr double kSameWidths = 0.5;
-// A still scene keeps the last segmented pair's mask for at most this long (µs): a segmentation that missed a
-// hand holding still (a finger resting on the table) is taken again within it, instead of for as long as
+// A still scene keeps the last segmented pair's mask for at most this long (µs): segmentations that missed a
+// hand holding still (a finger resting on the table) are taken again within it, instead of for as long as
 // the hand stays put.
 constexpr std::int64_t kMostStillUs = 100'000;
 // A pair whose S shows no code for the blur to be measured on is followed by this many without a try.
@@ -73,6 +73,7 @@ TouchPipeline::TouchPipeline(const DetectionOptions& options)
 void TouchPipeline::reset() {
     tracker_.reset();
     stillScene_.reset();
+    segmentationsWithoutFingertips_ = 0;
     rememberedCount_ = 0;
     result_.contacts.clear();
     result_.fingertips.clear();
@@ -169,14 +170,18 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     // again in every pair: a finger that moves less than the comparison sees (a pixel or two, within its
     // blocks' noise) still moves the region its height is read on, and a tip kept in place read false
     // touches (palm, seed 2: 4 false touch-downs in 14 instead of 1 in 9).
+    // A scene counts as without fingertips once two segmentations running found none: one pair's
+    // segmentation can lose a hand that the next finds again.
     const bool unchanged = stillScene_.matchesReference(result_.texture, result_.subtraction);
-    result_.sceneStill = unchanged && found_.empty() && result_.timestampUs - segmentedUs_ < kMostStillUs;
+    result_.sceneStill = unchanged && segmentationsWithoutFingertips_ >= 2 &&
+                         result_.timestampUs - segmentedUs_ < kMostStillUs;
     if (!result_.sceneStill) {
         segmenter_.segment(result_.texture, result_.subtraction, result_.handMask);
         findFingertips(result_.handMask, options_.fingertips, fingertipScratch_, found_,
                        segmenter_.judgedRegion());
         stillScene_.adoptAsReference();
         segmentedUs_ = result_.timestampUs;
+        segmentationsWithoutFingertips_ = found_.empty() ? segmentationsWithoutFingertips_ + 1 : 0;
     }
     measureFingertips(ordered, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,

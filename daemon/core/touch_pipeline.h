@@ -74,9 +74,9 @@ struct PipelineResult {
     cv::Mat subtraction;     // S, CV_16SC1
     cv::Mat texture;         // T, the frames' type
     cv::Mat handMask;        // CV_8UC1, 255 on the hand; all 0 when not detecting
-    // The scene, with no fingertip in it, matched the last segmented pair within the camera's noise
-    // (core/still_scene.h), segmented less than 0.1 s before: the mask is that pair's. Tracking ran on this
-    // pair.
+    // The scene matched the last segmented pair within the camera's noise (core/still_scene.h), segmented
+    // less than 0.1 s before, and that segmentation and the one before it found no fingertip: the mask is
+    // that pair's. Tracking ran on this pair.
     bool sceneStill = false;
     // The pair's frames were taken the other way round than they came labelled: the code's sign says which
     // shows O + P (core/polarity_lock.h). S, the height and everything after follow that order.
@@ -131,7 +131,8 @@ private:
     bool codeBlurMeasured_ = false;
     int pairsUntilBlurMeasure_ = 0;
     StillScene stillScene_;
-    std::int64_t segmentedUs_ = 0;  // the timestamp of the last pair segmented
+    std::int64_t segmentedUs_ = 0;            // the timestamp of the last pair segmented
+    int segmentationsWithoutFingertips_ = 0;  // running, up to the last
     SurfaceHeight height_;
     ContactTracker tracker_;
     FingertipScratch fingertipScratch_;
