@@ -134,8 +134,6 @@ public:
     // the table from something well above it.
     void measurePixels(HeightEvidence& evidence, std::size_t stride = 1);
 
-    // Candidate slopes in a fingertip's evidence (1 for a region searched flat).
-    std::size_t slopes() const { return slopeCount_; }
     // What one frame's evidence says of each slope.
     void supportSlopes(const HeightEvidence& evidence, SlopeSupport& support) const;
     // The slope the support favours, between the candidates; 0 without support.

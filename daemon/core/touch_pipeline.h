@@ -141,7 +141,6 @@ private:
     cv::Mat rigPattern_;
     double displayPixelsPerMm_ = 1.0;
     HeightEvidence frameEvidence_;
-    SlopeSupport frameSlopes_;
     // Fixed capacity (the most fingertips), so that remembering allocates nothing; counts say what is used.
     std::vector<Remembered> remembered_;
     std::vector<Remembered> rememberedNext_;

@@ -27,8 +27,7 @@ RecordingThread::~RecordingThread() {
 void RecordingThread::add(const core::Frame& frame,
                           const std::optional<std::vector<core::FingerTruth>>& truth,
                           const std::optional<cv::Mat>& mask) {
-    if (writer_.stopped())
-        return;
+    // Queued even after a write failed: the writer is the recording thread's alone, which drops the item.
     Item item{frame, truth, {}};
     if (mask) {
         item.mask = masks_.take();

@@ -102,7 +102,7 @@ TEST(SurfaceHeight, AtAGivenSlopeTheHeightIsReadBetweenTheTwoNearestSlopes) {
 
 TEST(SurfaceHeight, SlopeSupportAddsUpOverFramesAndNamesTheSlopeBetweenCandidates) {
     const SurfaceHeight height{HeightOptions{}};
-    ASSERT_EQ(height.slopes(), 5u);
+    ASSERT_EQ(height.hypotheses(), 5 * height.heights());
     // One frame fits slope 1.0 best by chance; five others fit slopes 0.5 and 1.0 about equally, 0.5 a
     // little better.
     const auto frameAt = [&](std::array<double, 5> best) {
