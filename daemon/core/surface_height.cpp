@@ -233,9 +233,17 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
     // centre), times the cosine of its ray's angle from the vertical.
     const double halfWidthPx = 0.5 * widthPx;
     const Eigen::Vector2d capCentre = tip - halfWidthPx * direction;
-    const double mmPerPx =
+    // Seen obliquely, the table is foreshortened towards the camera: a pixel along the finger covers up to a
+    // fifth more of it than a pixel across (the default rig's far rows). The width is measured across the
+    // finger, how far a pixel lies behind the cap along it.
+    const Eigen::Vector2d across(-direction.y(), direction.x());
+    const double alongMmPerPx =
         (onTable(undistortedAt(capCentre)) - onTable(undistortedAt(tip))).norm() / halfWidthPx;
-    const double halfThicknessMm = options_.thicknessPerWidth * halfWidthPx * mmPerPx;
+    const double acrossMmPerPx = (onTable(undistortedAt(capCentre + halfWidthPx * across)) -
+                                  onTable(undistortedAt(capCentre - halfWidthPx * across)))
+                                     .norm() /
+                                 widthPx;
+    const double halfThicknessMm = options_.thicknessPerWidth * halfWidthPx * acrossMmPerPx;
     const auto addShape = [&](int x, int y) {
         const Eigen::Vector2d offset = Eigen::Vector2d(x, y) - capCentre;
         const double behind = -offset.dot(direction);
@@ -243,7 +251,7 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
             behind > 0.0 ? std::abs(offset.x() * direction.y() - offset.y() * direction.x()) : offset.norm();
         const double t = std::min(1.0, fromAxis / halfWidthPx);
         const double belowTopAlongView = halfThicknessMm * (1.0 - std::sqrt(1.0 - t * t));
-        shape_.push_back({static_cast<float>(std::max(0.0, behind) * mmPerPx),
+        shape_.push_back({static_cast<float>(std::max(0.0, behind) * alongMmPerPx),
                           static_cast<float>(belowTopAlongView * verticalCosine(undistortedAt({x, y})))});
     };
     for (int y = y0; y <= y1; ++y) {

@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "core/camera_model.h"
 #include "core/code_image.h"
@@ -138,6 +141,79 @@ TEST(SurfaceHeightRendered, TheCodeThroughAPlaneGivesThatPlanesHeight) {
         ASSERT_TRUE(estimate.valid) << "at " << trueMm << " mm";
         EXPECT_NEAR(estimate.heightMm, trueMm, 1.0) << "one candidate step";
     }
+}
+
+TEST(SurfaceHeightRendered, AFingersThicknessIsTheSameWhereverItPoints) {
+    // A 16 mm wide finger lying on the table near its edge furthest from the camera, where the camera sees
+    // the table most obliquely, pointing away from the camera and across its view. The table is
+    // foreshortened there: a pixel along the view covers a fifth more of it than a pixel across, so a width
+    // read with the scale along the finger made a finger pointing away a fifth thicker, and its pad 2 mm
+    // lower, than the same finger pointing across.
+    sim::SimParameters parameters;
+    const cv::Mat pattern = sim::rigPattern(parameters);
+    sim::Simulator simulator(parameters, pattern);
+    const Calibration& calibration = simulator.calibration();
+    const HeightOptions options;
+    SurfaceHeight height(options);
+    height.setRig(calibration, pattern);
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    const auto toCamera = [&](const Eigen::Vector2d& tableMm) {
+        return camera.distortPixel(applyHomography(calibration.tableToCameraHomography(), tableMm));
+    };
+    const auto toTable = [&](double x, double y) {
+        return applyHomography(calibration.displayToTableHomography(), Eigen::Vector2d(x, y));
+    };
+    const double w = calibration.displaySize.width, h = calibration.displaySize.height;
+    Eigen::Vector2d farEdge = toTable(0.5 * w, 0.0);
+    for (const Eigen::Vector2d& edge : {toTable(0.5 * w, h), toTable(0.0, 0.5 * h), toTable(w, 0.5 * h)})
+        if (toCamera(edge).y() < toCamera(farEdge).y())
+            farEdge = edge;
+    const Eigen::Vector2d tableCentre = toTable(0.5 * w, 0.5 * h);
+    const Eigen::Vector2d tipMm = farEdge + 30.0 * (tableCentre - farEdge).normalized();
+
+    const cv::Mat blank(calibration.cameraSize, CV_8UC1, cv::Scalar(128));
+    const FramePair pair{Frame{blank, 0, 1, Polarity::Positive}, Frame{blank, 0, 0, Polarity::Negative}};
+    constexpr double kHalfWidthMm = 8.0;
+    const auto topAbovePadMm = [&](const Eigen::Vector2d& pointing) {
+        // 40 mm of finger, its end a half disc.
+        const Eigen::Vector2d side(-pointing.y(), pointing.x());
+        const Eigen::Vector2d capCentreMm = tipMm - kHalfWidthMm * pointing;
+        std::vector<cv::Point> outline;
+        const auto addCorner = [&](const Eigen::Vector2d& mm) {
+            const Eigen::Vector2d p = toCamera(mm);
+            outline.emplace_back(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y())));
+        };
+        for (int k = 0; k <= 18; ++k) {
+            const double angle = std::numbers::pi * k / 18.0;
+            addCorner(capCentreMm + kHalfWidthMm * (std::cos(angle) * side + std::sin(angle) * pointing));
+        }
+        addCorner(tipMm - 40.0 * pointing - kHalfWidthMm * side);
+        addCorner(tipMm - 40.0 * pointing + kHalfWidthMm * side);
+        cv::Mat mask(calibration.cameraSize, CV_8UC1, cv::Scalar(0));
+        cv::fillConvexPoly(mask, outline, cv::Scalar(255));
+        // The fingertip as the fingertip finder gives it: its end, its direction and its width across.
+        const Eigen::Vector2d tip = toCamera(tipMm);
+        const Eigen::Vector2d direction = (tip - toCamera(capCentreMm)).normalized();
+        const double widthPx = std::abs(
+            (toCamera(capCentreMm + kHalfWidthMm * side) - toCamera(capCentreMm - kHalfWidthMm * side))
+                .dot(Eigen::Vector2d(-direction.y(), direction.x())));
+        HeightEvidence evidence;
+        height.measureFingertip(pair, mask, tip, direction, widthPx, evidence);
+        EXPECT_GT(evidence.pixels, 50.0) << "a fingertip the camera resolves";
+        return evidence.topAbovePadTimesPixels / std::max(1.0, evidence.pixels);
+    };
+    const Eigen::Vector2d cameraOnTable = calibration.tableToCamera.inverse().translation().head<2>();
+    const Eigen::Vector2d away = (tipMm - cameraOnTable).normalized();
+    const double pointingAway = topAbovePadMm(away);
+    const double pointingAcross = topAbovePadMm(Eigen::Vector2d(-away.y(), away.x()));
+    // A half thickness above and below the cap's centre, the top seen along a ray 30-50 degrees from the
+    // vertical: 6 mm times 1.6-1.9.
+    const double halfThicknessMm = options.thicknessPerWidth * kHalfWidthMm;
+    for (const double mm : {pointingAway, pointingAcross}) {
+        EXPECT_GE(mm, 1.5 * halfThicknessMm);
+        EXPECT_LE(mm, 2.0 * halfThicknessMm);
+    }
+    EXPECT_NEAR(pointingAway, pointingAcross, 0.3) << "the same finger, turned";
 }
 
 TEST(SurfaceHeightRendered, ASlidingFingertipsHeightIsReadAndKeepsToItsSurface) {
