@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/camera_model.h"
+#include "core/finger_section.h"
 #include "core/geometry.h"
 
 namespace everytouch::core {
@@ -233,17 +234,27 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
     // centre), times the cosine of its ray's angle from the vertical.
     const double halfWidthPx = 0.5 * widthPx;
     const Eigen::Vector2d capCentre = tip - halfWidthPx * direction;
-    // Seen obliquely, the table is foreshortened towards the camera: a pixel along the finger covers up to a
-    // fifth more of it than a pixel across (the default rig's far rows). The width is measured across the
-    // finger, how far a pixel lies behind the cap along it.
-    const Eigen::Vector2d across(-direction.y(), direction.x());
     const double alongMmPerPx =
         (onTable(undistortedAt(capCentre)) - onTable(undistortedAt(tip))).norm() / halfWidthPx;
-    const double acrossMmPerPx = (onTable(undistortedAt(capCentre + halfWidthPx * across)) -
-                                  onTable(undistortedAt(capCentre - halfWidthPx * across)))
-                                     .norm() /
-                                 widthPx;
-    const double halfThicknessMm = options_.thicknessPerWidth * halfWidthPx * acrossMmPerPx;
+    // The finger's section from the silhouette's width, the angle between the rays along its sides at the
+    // distance of a finger resting there: seen obliquely, the table is foreshortened towards the camera and a
+    // finger stands above it, so the table's scale neither along the finger nor across it gives its width.
+    const Eigen::Vector2d across(-direction.y(), direction.x());
+    const Eigen::Vector3d view = rayThrough(undistortedAt(capCentre)).normalized();
+    const double apartRad = std::acos(
+        std::clamp(rayThrough(undistortedAt(capCentre + halfWidthPx * across))
+                       .normalized()
+                       .dot(rayThrough(undistortedAt(capCentre - halfWidthPx * across)).normalized()),
+                   -1.0, 1.0));
+    const Eigen::Vector2d pointing = onTable(undistortedAt(tip)) - onTable(undistortedAt(capCentre));
+    const double onTableHalfThicknessMm =
+        fingerSection(view, pointing, 0.5 * apartRad * cameraCentre_.z() / std::abs(view.z()),
+                      options_.thicknessPerWidth)
+            .halfThicknessMm;
+    const FingerSection section = fingerSection(
+        view, pointing, 0.5 * apartRad * (cameraCentre_.z() - onTableHalfThicknessMm) / std::abs(view.z()),
+        options_.thicknessPerWidth);
+    const double halfThicknessMm = section.halfThicknessMm;
     const auto addShape = [&](int x, int y) {
         const Eigen::Vector2d offset = Eigen::Vector2d(x, y) - capCentre;
         const double behind = -offset.dot(direction);
@@ -273,19 +284,20 @@ void SurfaceHeight::measureFingertip(const FramePair& pair, const cv::Mat& handM
         }
     }
     measurePixels(evidence);
-    // The top of the cap as the camera sees it lies a half thickness above the cap's centre times the
-    // cosine of the view's angle from the vertical, the lowest point a half thickness below.
-    evidence.topAbovePadTimesPixels =
-        evidence.pixels * halfThicknessMm * (1.0 + verticalCosine(undistortedAt(capCentre)));
+    evidence.topAbovePadTimesPixels = evidence.pixels * section.topAbovePadMm;
+}
+
+Eigen::Vector3d SurfaceHeight::rayThrough(const Eigen::Vector2d& undistorted) const {
+    return rayFromPixel_ * Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0);
 }
 
 double SurfaceHeight::verticalCosine(const Eigen::Vector2d& undistorted) const {
-    const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0);
+    const Eigen::Vector3d ray = rayThrough(undistorted);
     return std::abs(ray.z()) / ray.norm();
 }
 
 Eigen::Vector2d SurfaceHeight::onTable(const Eigen::Vector2d& undistorted) const {
-    const Eigen::Vector3d ray = rayFromPixel_ * Eigen::Vector3d(undistorted.x(), undistorted.y(), 1.0);
+    const Eigen::Vector3d ray = rayThrough(undistorted);
     if (std::abs(ray.z()) < 1e-12)
         return cameraCentre_.head<2>();
     return (cameraCentre_ - cameraCentre_.z() / ray.z() * ray).head<2>();

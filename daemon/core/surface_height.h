@@ -177,6 +177,8 @@ private:
                           std::array<float, kLanes>& squares, std::array<float, kLanes>& products) const;
     // Where an undistorted pixel's ray meets the table (mm), and the cosine of its angle from the vertical.
     Eigen::Vector2d onTable(const Eigen::Vector2d& undistorted) const;
+    // The ray through an undistorted pixel, table frame, from the camera's centre (not unit length).
+    Eigen::Vector3d rayThrough(const Eigen::Vector2d& undistorted) const;
     double verticalCosine(const Eigen::Vector2d& undistorted) const;
 
     HeightOptions options_;
