@@ -177,9 +177,9 @@ private:
                           std::array<float, kLanes>& squares, std::array<float, kLanes>& products) const;
     // Where an undistorted pixel's ray meets the table (mm), and the cosine of its angle from the vertical.
     Eigen::Vector2d onTable(const Eigen::Vector2d& undistorted) const;
+    double verticalCosine(const Eigen::Vector2d& undistorted) const;
     // The ray through an undistorted pixel, table frame, from the camera's centre (not unit length).
     Eigen::Vector3d rayThrough(const Eigen::Vector2d& undistorted) const;
-    double verticalCosine(const Eigen::Vector2d& undistorted) const;
 
     HeightOptions options_;
     cv::Mat panel_;                  // CV_32FC1: the pattern as skin and the camera blur it, projector pixels
