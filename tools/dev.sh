@@ -140,8 +140,9 @@ sanitize)
         'SystemFiles\.TheDebianPackageHoldsTheInstallAndLintianFindsNoError'
         'SystemFiles\.TheManualPagesHaveNoMandocWarning'
     )
-    # ctest's regular expressions (CMake's) take at most ten groups, and one with more matches nothing: one
-    # plain name an entry, and a check that the list left out at least as many tests as it names.
+    # ctest's regular expressions (CMake's, Henry Spencer's) hold at most nine groups, and one with more
+    # matches nothing: one plain name an entry, and a check that the list left out at least as many tests as
+    # it names.
     skips=$(IFS='|'; echo "${sanitizer_skips[*]}")
     all=$(ctest --test-dir build-sanitize -N | sed -n 's/^Total Tests: //p')
     kept=$(ctest --test-dir build-sanitize -N -E "^($skips)$" | sed -n 's/^Total Tests: //p')
