@@ -149,10 +149,10 @@ TEST(SurfaceHeightRendered, AFingertipsTopIsPlacedAboveItsPadWhereverItPoints) {
     // silhouette is its surface projected into the camera; the fingertip finder reads it as it reads any
     // mask. The height search reads the surface seen at the silhouette's middle, half a width behind its
     // end, and the pad lies below that by what the finger's section says. The truth: where that pixel's ray
-    // meets the finger, 12.0 and 11.3 mm up. Read: 12.9 and 11.6 mm (the mask's pixels add a pixel to the
-    // width). With the table's scale along the finger for its width and a top a half thickness above the
-    // axis times the view's cosine, the finger pointing away read 14.3 mm; with the table's scale across the
-    // finger, the one pointing across read 13.3 mm.
+    // meets the finger, 12.0 and 11.3 mm up. Read: 12.9 and 11.6 mm (the filled mask is 1-2 px wider than the
+    // projected finger). With the table's scale along the finger for its width and a top a half thickness
+    // above the axis times the view's cosine, the finger pointing away read 14.3 mm; with the table's scale
+    // across the finger, the one pointing across read 13.3 mm.
     sim::SimParameters parameters;
     const cv::Mat pattern = sim::rigPattern(parameters);
     sim::Simulator simulator(parameters, pattern);
