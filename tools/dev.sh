@@ -124,6 +124,15 @@ sanitize)
         # The daemon judges a stall against the camera's own pace, which the sanitizers slow several times: the
         # frame loop's stall test (FrameLoopTest) and the pipeline's frames of another size run instead.
         'ServiceTest\.ACameraThatStallsOrChangesItsFramesSizeReleasesEveryContactUntilItsFramesFitAgain'
+        # Waits of the daemon's own pace and of the table's set-up step, run again on code that other cases
+        # run under the sanitizers (12-27 s each): the monitor's lines (TheMonitorEnds..., TheMonitorSays...),
+        # a calibration refused while one runs (AClientThatFloodsCalibrate...), the set-up step waiting for the
+        # board (RecoversTheTableAndFitsTheDisplay), a recording without a hand scored (the scoring's units).
+        'ServiceTest\.TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem'
+        'ServiceTest\.ASecondCalibrationWhileOneRunsIsBusy'
+        'TableSetUpStep\.AfterAnotherStepWaitsUntilTheBoardIsTakenAway'
+        'TableSetUpStep\.AfterAnotherStepTakesABoardGoneBeforeItBegan'
+        'EverytouchEval\.ARecordingWithoutAHandIsScoredNotRefused'
         # The fake GigE camera rendering the simulated rig on its thread (minutes under ASan): the GigE path runs
         # in the camera's other tests, detection in the pipeline's. The projector window: SDL2 unloads at its end
         # the libraries it loaded, and LeakSanitizer reports what they keep in frames it cannot name; the window
