@@ -539,17 +539,25 @@ const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx)
     if (known)
         return feature.val;
     const int blockPx = options_.blockPx, channels = texture.channels();
-    int sums[3] = {0, 0, 0};
+    // Each channel's sum in a local of its own: added through an array indexed by channel, every addition
+    // went through memory.
+    int blue = 0, green = 0, red = 0;
     for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
         const uchar* row = texture.ptr<uchar>(y) + bx * blockPx * channels;
-        for (int x = 0; x < blockPx * channels; x += channels)
-            for (int c = 0; c < channels; ++c)
-                sums[c] += row[x + c];
+        if (channels == 3) {
+            for (int x = 0; x < 3 * blockPx; x += 3) {
+                blue += row[x];
+                green += row[x + 1];
+                red += row[x + 2];
+            }
+        } else {
+            for (int x = 0; x < blockPx; ++x)
+                blue += row[x];
+        }
     }
     const float scale = 1.0f / static_cast<float>(blockPx * blockPx);
-    float colour[3] = {0.0f, 0.0f, 0.0f};
-    for (int c = 0; c < channels; ++c)
-        colour[c] = static_cast<float>(sums[c]) * scale;
+    const float colour[3] = {static_cast<float>(blue) * scale, static_cast<float>(green) * scale,
+                             static_cast<float>(red) * scale};
     colourFeature(colour, channels, feature.val);
     known = 1;
     return feature.val;
