@@ -84,20 +84,23 @@ const std::array<cv::Point, kColourSamples>& colourSampleOffsets() {
 }
 
 // Colour features of one side of the outline, and the squared distance from a pixel's feature to the nearest
-// of them. Each component is kept in its own array so that four samples are compared at once; the array's
-// tail repeats the last sample up to a multiple of four, which changes no minimum.
+// of them. Each component is kept in its own array so that four samples are compared at once; once all are
+// added, finish() repeats the last sample up to a multiple of four, which changes no minimum.
 class NearestColour {
 public:
-    void clear() { count_ = 0; }
     bool empty() const { return count_ == 0; }
     void add(const float* feature) {
-        const int end = (count_ + kLanes) / kLanes * kLanes;
-        for (int k = count_; k < end; ++k) {
-            first_[k] = feature[0];
-            second_[k] = feature[1];
-            third_[k] = feature[2];
-        }
+        first_[count_] = feature[0];
+        second_[count_] = feature[1];
+        third_[count_] = feature[2];
         ++count_;
+    }
+    void finish() {
+        for (int k = count_; k % kLanes != 0; ++k) {
+            first_[k] = first_[count_ - 1];
+            second_[k] = second_[count_ - 1];
+            third_[k] = third_[count_ - 1];
+        }
     }
     float nearestDistance(const float* feature) const {
         const Query query(feature);
@@ -756,6 +759,7 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
     litColumns_.resize(static_cast<std::size_t>(blockPx + 2 * kLitReach));
     measureDepthInHand();
     const auto pure = [&](int y, int x) { return depthInHand_.at<uchar>(y, x) > depth; };
+    const std::array<cv::Point, kColourSamples>& sampleOffsets = colourSampleOffsets();
     // Only the blocks next to the hand's are looked at.
     for (int by = std::max(handBox_.y - 1, 0); by <= std::min(handBox_.br().y, rows - 1); ++by)
         for (int bx = std::max(handBox_.x - 1, 0); bx <= std::min(handBox_.br().x, cols - 1); ++bx) {
@@ -777,7 +781,7 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             // On the outline: each pixel goes to the side whose nearby clean colour it resembles more.
             NearestColour hand, other, looseHand;
             for (int k = 0; k < kColourSamples && !inside; ++k) {
-                const int y = by + colourSampleOffsets()[k].y, x = bx + colourSampleOffsets()[k].x;
+                const int y = by + sampleOffsets[k].y, x = bx + sampleOffsets[k].x;
                 const uchar n = classAt(y, x);
                 if (n == Outside)
                     continue;
@@ -790,6 +794,9 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     other.add(colour);
                 }
             }
+            hand.finish();
+            looseHand.finish();
+            other.finish();
             const NearestColour& handSide = hand.empty() ? looseHand : hand;
             // A pixel in the hand's own shadow gets no light from the projector, and no code: whatever its
             // colour, it is not the hand (a hand over black content loses its outline pixels here too).
