@@ -536,11 +536,13 @@ void HandSegmenter::keepHandComponents(const cv::Mat& subtraction) {
     }
 }
 
-const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx) {
+inline const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx) {
+    const float* feature = blockColour_.ptr<cv::Vec3f>(by)[bx].val;
+    return colourKnown_.ptr<uchar>(by)[bx] ? feature : measureBlockFeature(texture, by, bx);
+}
+
+const float* HandSegmenter::measureBlockFeature(const cv::Mat& texture, int by, int bx) {
     cv::Vec3f& feature = blockColour_.at<cv::Vec3f>(by, bx);
-    uchar& known = colourKnown_.at<uchar>(by, bx);
-    if (known)
-        return feature.val;
     const int blockPx = options_.blockPx, channels = texture.channels();
     // Each channel's sum in a local of its own: added through an array indexed by channel, every addition
     // went through memory.
@@ -562,7 +564,7 @@ const float* HandSegmenter::blockFeature(const cv::Mat& texture, int by, int bx)
     const float colour[3] = {static_cast<float>(blue) * scale, static_cast<float>(green) * scale,
                              static_cast<float>(red) * scale};
     colourFeature(colour, channels, feature.val);
-    known = 1;
+    colourKnown_.at<uchar>(by, bx) = 1;
     return feature.val;
 }
 
@@ -803,10 +805,20 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
             // Beyond the brightest code the table shows, S is not code but the scene changing between the two
             // frames: a moving edge or a shadow sweeping over the table. It says nothing about light.
             const int side = blockPx + 2 * kLitReach;
+            // Clamped to the image only where the patch reaches beyond it.
+            const bool withinImage = block.x >= kLitReach && block.y >= kLitReach &&
+                                     block.x + blockPx + kLitReach <= subtraction.cols &&
+                                     block.y + blockPx + kLitReach <= subtraction.rows;
             for (int py = 0; py < side; ++py) {
                 const short* s =
                     subtraction.ptr<short>(std::clamp(block.y - kLitReach + py, 0, subtraction.rows - 1));
                 int* patch = litPatch_.data() + py * side;
+                if (withinImage) {
+                    const short* from = s + block.x - kLitReach;
+                    for (int px = 0; px < side; ++px)
+                        patch[px] = from[px] <= motionLevel ? from[px] : 0;
+                    continue;
+                }
                 for (int px = 0; px < side; ++px) {
                     const int value = s[std::clamp(block.x - kLitReach + px, 0, subtraction.cols - 1)];
                     patch[px] = value <= motionLevel ? value : 0;

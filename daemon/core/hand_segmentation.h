@@ -106,8 +106,11 @@ private:
     int floodComponent(int start, uchar from, uchar to);
     void keepHandComponents(const cv::Mat& subtraction);
     bool liesOnTable(const cv::Mat& subtraction, int size);
-    // A block's mean colour as colourFeature makes it, measured on first use in a frame.
+    // A block's mean colour as colourFeature makes it, measured on first use in a frame: blockFeature is the
+    // lookup, inlined where the outline's and the table's samples are read (some 57 000 times a pair with
+    // one hand in view on grid35), measureBlockFeature the measurement.
     const float* blockFeature(const cv::Mat& texture, int by, int bx);
+    const float* measureBlockFeature(const cv::Mat& texture, int by, int bx);
     // The squared colour distance from block `block` to the nearest block within `reach` that isSample(index)
     // takes as the table's, or the largest float without one: measured once per growth step (tableDistance_,
     // which the step clears), since a block beside several hand blocks is judged from each.
