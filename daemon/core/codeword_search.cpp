@@ -62,8 +62,9 @@ std::vector<Chunk> splitIntoChunks(int codeBits, int count) {
 
 }  // namespace
 
-void forEachPairWithin(const std::vector<std::uint64_t>& codes, int codeBits, int radius,
-                       const std::function<void(int a, int b, int distance)>& visit) {
+EVERYTOUCH_HARDWARE_POPCOUNT void forEachPairWithin(
+    const std::vector<std::uint64_t>& codes, int codeBits, int radius,
+    const std::function<void(int a, int b, int distance)>& visit) {
     CV_Assert(codeBits >= 1 && codeBits <= 64 && radius >= 0 && radius <= kMaxCodewordSearchRadius);
     const double n = static_cast<double>(codes.size());
     int chunkCount = 0;

@@ -11,6 +11,12 @@ namespace everytouch::core {
 // space of up to 64 bits, hundreds of thousands of codewords, radius up to kMaxCodewordSearchRadius).
 inline constexpr int kMaxCodewordSearchRadius = 5;
 
+// Debian's amd64 baseline has no POPCNT instruction: std::popcount compiles to a library call there, which
+// took 15 % of the default pattern's generation. The searches are compiled twice, the loader choosing the
+// version with the instruction where the processor has it. On a function's definition only: a declaration
+// would make every file that includes it resolve between clones it does not have.
+#define EVERYTOUCH_HARDWARE_POPCOUNT __attribute__((target_clones("popcnt", "default")))
+
 // Calls visit(a, b, distance) once for every pair a < b of `codes` (each codeBits long) at Hamming distance
 // <= radius. Pigeonhole: split the codewords into m chunks; two codewords within `radius` agree to within
 // radius / m bits on one chunk, so only codewords in nearby chunk groups are compared. m is chosen per call
@@ -38,7 +44,8 @@ public:
 
     // Calls visit(id, distance) once for every stored codeword within radius of `query`.
     template <typename Visit>
-    EVERYTOUCH_UNCHECKED_PROBES void forEachWithin(std::uint64_t query, Visit&& visit) const {
+    EVERYTOUCH_UNCHECKED_PROBES EVERYTOUCH_HARDWARE_POPCOUNT void forEachWithin(std::uint64_t query,
+                                                                                Visit&& visit) const {
         // The probes are independent cache misses: announce them all first so that they overlap.
         for (int half = 0; half < 2; ++half)
             for (std::uint64_t variant : variants_[half])
