@@ -15,7 +15,17 @@ inline constexpr int kMaxCodewordSearchRadius = 5;
 // took 15 % of the default pattern's generation. The searches are compiled twice, the loader choosing the
 // version with the instruction where the processor has it. On a function's definition only: a declaration
 // would make every file that includes it resolve between clones it does not have.
+// Not under the sanitizers: they instrument the loader's choice too, which runs before their runtime exists.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define EVERYTOUCH_HARDWARE_POPCOUNT
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define EVERYTOUCH_HARDWARE_POPCOUNT
+#endif
+#endif
+#ifndef EVERYTOUCH_HARDWARE_POPCOUNT
 #define EVERYTOUCH_HARDWARE_POPCOUNT __attribute__((target_clones("popcnt", "default")))
+#endif
 
 // Calls visit(a, b, distance) once for every pair a < b of `codes` (each codeBits long) at Hamming distance
 // <= radius. Pigeonhole: split the codewords into m chunks; two codewords within `radius` agree to within

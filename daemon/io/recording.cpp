@@ -347,14 +347,21 @@ void RecordingWriter::takeBackOpenFrame() noexcept {
     openFrameListed_ = false;
 }
 
-void RecordingWriter::writeImage(const std::filesystem::path& path, const cv::Mat& image) {
-    if (!cv::imencode(".png", image, encoded_))
+bool RecordingWriter::encodePng(const cv::Mat& image, std::vector<uchar>& png) {
+    return cv::imencode(".png", image, png);
+}
+
+void RecordingWriter::encodeOpenImage(const std::filesystem::path& path, const cv::Mat& image) {
+    if (!encodePng(image, encoded_))
         throw std::runtime_error(path.string() + ": the image cannot be encoded as PNG");
+}
+
+void RecordingWriter::writeImage(const std::filesystem::path& path, std::span<const uchar> png) {
     UniqueFd file(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
     if (!file)
         throw std::system_error(errno, std::generic_category(), path.string());
     openImages_.push_back(path);
-    writeAll(file, std::string_view(reinterpret_cast<const char*>(encoded_.data()), encoded_.size()), path);
+    writeAll(file, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()), path);
     if (::close(file.release()) != 0)
         throw std::system_error(errno, std::generic_category(), path.string());
 }
@@ -378,8 +385,14 @@ void RecordingWriter::appendLine(const UniqueFd& table, std::string_view line,
 }
 
 void RecordingWriter::addFrame(const core::Frame& frame) {
+    guarded(frame.index,
+            [&] { encodeOpenImage(Recording::framePath(directory_, frame.index), frame.image); });
+    addFrame(frame, encoded_);
+}
+
+void RecordingWriter::addFrame(const core::Frame& frame, std::span<const uchar> png) {
     guarded(frame.index, [&] {
-        writeImage(Recording::framePath(directory_, frame.index), frame.image);
+        writeImage(Recording::framePath(directory_, frame.index), png);
         char line[96];
         const int length =
             std::snprintf(line, sizeof line, "%llu,%lld,%d\n", static_cast<unsigned long long>(frame.index),
@@ -408,12 +421,23 @@ void RecordingWriter::addTruth(const std::vector<core::FingerTruth>& fingers) {
     });
 }
 
-void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
+void RecordingWriter::checkMask(const cv::Mat& mask) const {
     if (!withMasks_)
         throw std::logic_error("addMask: the recording was started without masks");
     if (mask.type() != CV_8UC1 || mask.size() != cameraSize_)
         throw std::invalid_argument("addMask: expected an 8-bit single-channel mask of the camera size");
-    guarded(frameIndex, [&] { writeImage(Recording::maskPath(directory_, frameIndex), mask); });
+}
+
+void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
+    checkMask(mask);
+    guarded(frameIndex, [&] { encodeOpenImage(Recording::maskPath(directory_, frameIndex), mask); });
+    addMask(frameIndex, encoded_);
+}
+
+void RecordingWriter::addMask(std::uint64_t frameIndex, std::span<const uchar> png) {
+    if (!withMasks_)
+        throw std::logic_error("addMask: the recording was started without masks");
+    guarded(frameIndex, [&] { writeImage(Recording::maskPath(directory_, frameIndex), png); });
 }
 
 void RecordingWriter::flush() {

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -80,10 +81,20 @@ public:
                     bool withMasks = false);
 
     void addFrame(const core::Frame& frame);
+    // The same with the frame's image already encoded by encodePng (on another thread: encoding is what
+    // takes the time).
+    void addFrame(const core::Frame& frame, std::span<const uchar> png);
     void addTruth(const std::vector<core::FingerTruth>& fingers);
-    // The hand mask of frame `frameIndex`: CV_8UC1, camera size, 0 and 255. Throws std::logic_error for a
-    // writer without masks and std::invalid_argument for another type or size.
+    // The hand mask of frame `frameIndex`: CV_8UC1, camera size, 0 and 255. Throws what checkMask throws.
     void addMask(std::uint64_t frameIndex, const cv::Mat& mask);
+    // The same with a mask that passed checkMask, encoded by encodePng.
+    void addMask(std::uint64_t frameIndex, std::span<const uchar> png);
+    // Throws std::logic_error for a writer without masks and std::invalid_argument for a mask of another type
+    // or size.
+    void checkMask(const cv::Mat& mask) const;
+    // An image as the recording's files hold it (PNG); false when it cannot be encoded. Safe to call from any
+    // thread.
+    [[nodiscard]] static bool encodePng(const cv::Mat& image, std::vector<uchar>& png);
     // Completes the last frame and puts the tables on the disk (fdatasync).
     void flush();
 
@@ -101,7 +112,9 @@ private:
     template <typename Write>
     void guarded(std::uint64_t index, Write write);
     void takeBackOpenFrame() noexcept;
-    void writeImage(const std::filesystem::path& path, const cv::Mat& image);
+    // Encodes an image of the frame being written into encoded_, or throws naming its file.
+    void encodeOpenImage(const std::filesystem::path& path, const cv::Mat& image);
+    void writeImage(const std::filesystem::path& path, std::span<const uchar> png);
     static void writeAll(const UniqueFd& file, std::string_view bytes, const std::filesystem::path& path);
     // Appends to frames.csv or truth.csv, whose bytes `size` counts.
     static void appendLine(const UniqueFd& table, std::string_view line, const std::filesystem::path& path,

@@ -47,7 +47,9 @@ FrameLoop::FrameLoop(io::FrameSource& source, core::PairPipeline& pipeline, std:
       queue_(options.queueCapacity, options.overflow),
       // Every frame that can be held at once: those queued, the one paired with the next, one being filled,
       // and those waiting to be recorded.
-      spareFrames_(options.queueCapacity + 2 + (recorder ? options.recordingCapacity + 1 : 0)),
+      spareFrames_(
+          options.queueCapacity + 2 +
+          (recorder ? RecordingThread::imagesHeld(options.recordingCapacity, options.recordingEncoders) : 0)),
       settings_(std::move(settings)),
       pipelineMs_(kPipelineSamples, 0.0) {}
 
@@ -62,8 +64,9 @@ void FrameLoop::start() {
     }
     heartbeatNs_ = Clock::now().time_since_epoch().count();
     if (recorder_)
-        recording_.emplace(*recorder_, options_.recordingCapacity, options_.overflow, spareFrames_,
-                           [this](const std::string& problem) { stopRecording(problem); });
+        recording_.emplace(
+            *recorder_, options_.recordingCapacity, options_.overflow, spareFrames_,
+            [this](const std::string& problem) { stopRecording(problem); }, options_.recordingEncoders);
     pipelineThread_ = std::thread([this] {
         io::nameThisThread("et-pipeline");
         runPipeline();

@@ -54,6 +54,8 @@ struct LoopOptions {
     // Frames waiting to be written to the recording: a live camera's burst of 67 ms at 120 Hz while the disk
     // is busy.
     std::size_t recordingCapacity = 8;
+    // Threads that encode the recording's frames (service/recording_thread.h).
+    int recordingEncoders = RecordingThread::defaultEncoders();
     // A live camera that delivers no frame for this long has stalled: every contact is released and detection
     // waits for frames. Nothing for sources that can wait (a replay or simulation run fast).
     std::optional<std::chrono::milliseconds> stallAfter;

@@ -85,6 +85,49 @@ TEST_F(RecordingThreadTest, ACameraIsNotHeldUpByTheDiskButFramesLeftOutAreCounte
     EXPECT_EQ(recorded.frames().back().index, kFrames - 1);
 }
 
+TEST_F(RecordingThreadTest, SeveralEncodersWriteEachFramesOwnImageInTheOrderTheyWereTaken) {
+    io::RecordingWriter writer(dir_ / "rec", rig_, true, true);
+    constexpr int kFrames = 24;
+    std::vector<cv::Mat> given;
+    {
+        RecordingThread recording(writer, 4, QueueOverflow::Block, images_, onStop_, 3);
+        cv::Mat mask(rig_.calibration.cameraSize, CV_8UC1);
+        for (int index = 0; index < kFrames; ++index) {
+            // Noise takes an encoder far longer than a flat frame, so later frames are encoded first.
+            core::Frame frame = noiseFrame(static_cast<std::uint64_t>(index), rig_.calibration.cameraSize);
+            if (index % 3 != 0)
+                frame.image = cv::Scalar(index, 2 * index, 3 * index);
+            given.push_back(frame.image.clone());
+            mask = cv::Scalar(index % 2 == 0 ? 255 : 0);
+            recording.add(
+                frame, std::vector<core::FingerTruth>{{static_cast<std::uint64_t>(index), 1, 0, 0, 0}}, mask);
+        }
+        recording.finish();
+        EXPECT_EQ(recording.dropped(), 0u);
+    }
+    EXPECT_EQ(stops_, 0);
+    const io::Recording recorded = io::Recording::open(dir_ / "rec");
+    ASSERT_EQ(recorded.frames().size(), static_cast<std::size_t>(kFrames));
+    for (int position = 0; position < kFrames; ++position) {
+        EXPECT_EQ(recorded.frames()[position].index, static_cast<std::uint64_t>(position));
+        EXPECT_EQ(recorded.truth()[position].frameIndex, static_cast<std::uint64_t>(position));
+        EXPECT_EQ(cv::norm(recorded.loadFrame(position).image, given[position], cv::NORM_INF), 0.0)
+            << position;
+        EXPECT_EQ(cv::countNonZero(recorded.loadMask(position)) > 0, position % 2 == 0) << position;
+    }
+}
+
+TEST_F(RecordingThreadTest, AMaskTheWriterWouldRefuseIsRefusedWhenAdded) {
+    io::RecordingWriter writer(dir_ / "rec", rig_, false, true);
+    RecordingThread recording(writer, 2, QueueOverflow::Block, images_, onStop_);
+    const cv::Mat wrongSize(rig_.calibration.cameraSize.height + 1, rig_.calibration.cameraSize.width,
+                            CV_8UC1, cv::Scalar(0));
+    EXPECT_THROW(recording.add(noiseFrame(0, rig_.calibration.cameraSize), std::nullopt, wrongSize),
+                 std::invalid_argument);
+    EXPECT_THROW(RecordingThread(writer, 2, QueueOverflow::Block, images_, onStop_, 0),
+                 std::invalid_argument);
+}
+
 TEST_F(RecordingThreadTest, AFramesImageGoesBackToThePoolWhenTheLastOfItsHoldersIsDone) {
     io::RecordingWriter writer(dir_ / "rec", rig_, false);
     RecordingThread recording(writer, 2, QueueOverflow::Block, images_, onStop_);
