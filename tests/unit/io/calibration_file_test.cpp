@@ -105,6 +105,18 @@ TEST_F(CalibrationFileTest, RejectsTruncatedFile) {
     EXPECT_THROW(readCalibrationFile(badPath_), InputError);
 }
 
+TEST_F(CalibrationFileTest, ReadsAFileUpToAMebibyteAndRefusesALargerOne) {
+    // A calibration padded with a comment, read in pieces to its last byte.
+    const std::size_t mebibyte = std::size_t{1} << 20;
+    const std::string padded = goodText_ + "# " + std::string(mebibyte - goodText_.size() - 3, 'x') + "\n";
+    ASSERT_EQ(padded.size(), mebibyte);
+    test::writeText(badPath_, padded);
+    EXPECT_EQ(readCalibrationFile(badPath_).cameraSize, readCalibrationFile(good_).cameraSize);
+    test::writeText(badPath_, padded + "\n");
+    EXPECT_THAT([&] { readCalibrationFile(badPath_); },
+                ::testing::ThrowsMessage<InputError>(AllOf(HasSubstr("bad.yml"), HasSubstr("1 MiB"))));
+}
+
 TEST_F(CalibrationFileTest, RejectsGarbageAndMissingFile) {
     test::writeText(badPath_, "{{{ this is : not [ yaml");
     EXPECT_THROW(readCalibrationFile(badPath_), InputError);
