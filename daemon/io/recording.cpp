@@ -106,12 +106,34 @@ void requirePngOfSize(const std::filesystem::path& path, const cv::Size& size, c
                              std::to_string(width) + "x" + std::to_string(height));
 }
 
+// The type of the file at `path`. A path the system refuses outright (a name too long, a loop of links) is an
+// input error naming it, not a filesystem exception.
+std::filesystem::file_type typeOf(const std::filesystem::path& path) {
+    std::error_code error;
+    const std::filesystem::file_status status = std::filesystem::status(path, error);
+    if (error && status.type() == std::filesystem::file_type::none)
+        throw InputError(path.string(), "", "cannot be accessed (" + error.message() + ")");
+    return status.type();
+}
+
+bool isRegularFile(const std::filesystem::path& path) {
+    return typeOf(path) == std::filesystem::file_type::regular;
+}
+
+bool isDirectory(const std::filesystem::path& path) {
+    return typeOf(path) == std::filesystem::file_type::directory;
+}
+
+bool isPresent(const std::filesystem::path& path) {
+    return typeOf(path) != std::filesystem::file_type::not_found;
+}
+
 // Reads an 8-bit single-channel image of `size` that holds only 0 and 255; `sizeName` says whose size it must
 // have.
 cv::Mat readBinaryImage(const std::filesystem::path& path, const cv::Size& size,
                         const std::string& sizeName) {
     const std::string name = path.string();
-    if (!std::filesystem::is_regular_file(path))
+    if (!isRegularFile(path))
         throw InputError(name, "", "missing");
     requirePngOfSize(path, size, sizeName);
     cv::Mat image = cv::imread(name, cv::IMREAD_UNCHANGED);
@@ -148,7 +170,7 @@ std::filesystem::path Recording::maskPath(const std::filesystem::path& directory
 Recording Recording::open(const std::filesystem::path& directory) {
     Recording recording;
     recording.directory_ = directory;
-    if (!std::filesystem::is_directory(directory))
+    if (!isDirectory(directory))
         throw InputError(directory.string(), "", "not a recording directory");
 
     const std::filesystem::path rigPath = directory / "rig.yml";
@@ -180,7 +202,7 @@ Recording Recording::open(const std::filesystem::path& directory) {
     rig.pattern = readPatternImage(directory / pattern.string(), rig.calibration.projectorSize);
 
     const std::filesystem::path framesPath = directory / "frames.csv";
-    if (!std::filesystem::is_regular_file(framesPath))
+    if (!isRegularFile(framesPath))
         throw InputError(framesPath.string(), "", "missing");
     readCsv(framesPath, "index,timestamp_us,polarity", 3, [&](const auto& fields, const std::string& where) {
         FrameEntry entry;
@@ -199,25 +221,25 @@ Recording Recording::open(const std::filesystem::path& directory) {
             if (entry.timestampUs < previous.timestampUs)
                 throw InputError(framesPath.string(), where, "timestamp_us: goes back in time");
         }
-        if (!std::filesystem::is_regular_file(framePath(directory, entry.index)))
+        if (!isRegularFile(framePath(directory, entry.index)))
             throw InputError(framePath(directory, entry.index).string(), "",
                              "missing (listed in frames.csv " + where + ")");
         recording.frames_.push_back(entry);
     });
 
     const std::filesystem::path masksPath = directory / "masks";
-    if (std::filesystem::exists(masksPath)) {
-        if (!std::filesystem::is_directory(masksPath))
+    if (isPresent(masksPath)) {
+        if (!isDirectory(masksPath))
             throw InputError(masksPath.string(), "", "expected a directory of hand masks");
         recording.hasMasks_ = true;
         for (const FrameEntry& entry : recording.frames_)
-            if (!std::filesystem::is_regular_file(maskPath(directory, entry.index)))
+            if (!isRegularFile(maskPath(directory, entry.index)))
                 throw InputError(maskPath(directory, entry.index).string(), "",
                                  "missing (masks/ needs a mask for every frame in frames.csv)");
     }
 
     const std::filesystem::path truthPath = directory / "truth.csv";
-    if (std::filesystem::exists(truthPath)) {
+    if (isPresent(truthPath)) {
         recording.hasTruth_ = true;
         readCsv(truthPath, "index,id,x,y,height_mm", 5, [&](const auto& fields, const std::string& where) {
             core::FingerTruth finger;
@@ -273,7 +295,7 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& directory, const R
                                  bool withTruth, bool withMasks)
     : directory_(directory), cameraSize_(rig.calibration.cameraSize), withMasks_(withMasks) {
     std::error_code error;
-    if (std::filesystem::exists(directory) && !std::filesystem::is_empty(directory))
+    if (isPresent(directory) && !std::filesystem::is_empty(directory))
         throw InputError(directory.string(), "", "exists and is not empty; choose a new recording directory");
     if (!std::filesystem::create_directories(directory / "frames", error) && error)
         throw InputError(directory.string(), "", "cannot be created: " + error.message());

@@ -250,6 +250,13 @@ TEST_F(RecordingTest, RejectsBadCalibrationInRig) {
     EXPECT_THAT(complaint(), AllOf(HasSubstr("rig.yml"), HasSubstr("projector_matrix")));
 }
 
+TEST_F(RecordingTest, APatternNameTheSystemRefusesIsNamedNotThrownAsAFilesystemError) {
+    // Found by fuzzing: one component longer than any file name may be.
+    const std::string tooLong(300, 'p');
+    edit("rig.yml", "pattern: \"pattern.png\"", "pattern: \"" + tooLong + ".png\"");
+    EXPECT_THAT(complaint(), AllOf(HasSubstr(tooLong), HasSubstr("cannot be accessed")));
+}
+
 TEST_F(RecordingTest, RejectsPatternOfWrongSizeOrValues) {
     cv::imwrite((dir_ / "pattern.png").string(), cv::Mat(100, 100, CV_8UC1, cv::Scalar(255)));
     EXPECT_THAT(complaint(), AllOf(HasSubstr("pattern.png"), HasSubstr("projector size")));
