@@ -451,8 +451,12 @@ void RecordingWriter::checkMask(const cv::Mat& mask) const {
 }
 
 void RecordingWriter::addMask(std::uint64_t frameIndex, const cv::Mat& mask) {
-    checkMask(mask);
-    guarded(frameIndex, [&] { encodeOpenImage(Recording::maskPath(directory_, frameIndex), mask); });
+    // A mask refused takes its frame back and stops the writer, as a failed write does: the frame's files
+    // are kept or dropped together.
+    guarded(frameIndex, [&] {
+        checkMask(mask);
+        encodeOpenImage(Recording::maskPath(directory_, frameIndex), mask);
+    });
     addMask(frameIndex, encoded_);
 }
 

@@ -62,7 +62,6 @@ void RecordingThread::add(const core::Frame& frame,
     // Queued even after a write failed: the writer is the writer thread's alone, which drops the item.
     Item item{frame, truth, {}, 0, {}, {}};
     if (mask) {
-        writer_.checkMask(*mask);
         item.mask = masks_.take();
         mask->copyTo(item.mask);
     }
@@ -97,16 +96,24 @@ void RecordingThread::encode() {
             std::lock_guard lock(mutex_);
             ++taken_;
         }
-        // Where encoding fails, the writer encodes the frame again, fails as here and stops the recording,
-        // naming the file.
-        try {
-            if (!io::RecordingWriter::encodePng(item.frame.image, item.encodedImage))
-                item.encodedImage.clear();
-            if (!item.mask.empty() && !io::RecordingWriter::encodePng(item.mask, item.encodedMask))
+        // Left empty where encoding fails or the writer refuses the mask: the writer then takes the image
+        // itself, fails as here and stops the recording, naming the file.
+        const auto encodeInto = [](const cv::Mat& image, std::vector<uchar>& png) {
+            try {
+                if (io::RecordingWriter::encodePng(image, png))
+                    return;
+            } catch (const std::exception&) {
+            }
+            png.clear();
+        };
+        encodeInto(item.frame.image, item.encodedImage);
+        if (!item.mask.empty()) {
+            try {
+                writer_.checkMask(item.mask);
+                encodeInto(item.mask, item.encodedMask);
+            } catch (const std::exception&) {
                 item.encodedMask.clear();
-        } catch (const std::exception&) {
-            item.encodedImage.clear();
-            item.encodedMask.clear();
+            }
         }
         {
             std::lock_guard lock(mutex_);

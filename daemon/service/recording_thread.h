@@ -49,8 +49,8 @@ public:
     RecordingThread& operator=(const RecordingThread&) = delete;
 
     // Queues the frame (its image shared, not copied: a camera fills a new buffer for each frame) and a
-    // copy of the truth's mask, which the simulator draws again for the next frame. Throws
-    // std::invalid_argument for a mask the writer would refuse.
+    // copy of the truth's mask, which the simulator draws again for the next frame. A mask the writer
+    // refuses stops the recording, as a failed write does.
     void add(const core::Frame& frame, const std::optional<std::vector<core::FingerTruth>>& truth,
              const std::optional<cv::Mat>& mask);
     // Writes what is queued, puts the recording's tables on the disk and ends the threads; once.

@@ -136,13 +136,21 @@ TEST_F(RecordingTest, WriterWithoutMasksWritesNoMasksDirectory) {
     EXPECT_FALSE(Recording::open(other / "rec").hasMasks());
 }
 
-TEST_F(RecordingTest, WriterRefusesAMaskOfAnotherSizeOrType) {
-    test::TempDir other;
-    RecordingWriter writer(other / "rec", rig_, false, true);
-    writer.addFrame(frames_[0]);
-    EXPECT_THROW(writer.addMask(0, cv::Mat(10, 10, CV_8UC1, cv::Scalar(0))), std::invalid_argument);
-    EXPECT_THROW(writer.addMask(0, cv::Mat(rig_.calibration.cameraSize, CV_8UC3, cv::Scalar::all(0))),
-                 std::invalid_argument);
+TEST_F(RecordingTest, WriterRefusesAMaskOfAnotherSizeOrTypeAndTakesItsFrameBack) {
+    for (const cv::Mat& refused : {cv::Mat(10, 10, CV_8UC1, cv::Scalar(0)),
+                                   cv::Mat(rig_.calibration.cameraSize, CV_8UC3, cv::Scalar::all(0))}) {
+        test::TempDir other;
+        RecordingWriter writer(other / "rec", rig_, false, true);
+        writer.addFrame(frames_[0]);
+        writer.addMask(0, cv::Mat(rig_.calibration.cameraSize, CV_8UC1, cv::Scalar(0)));
+        writer.addFrame(frames_[1]);
+        EXPECT_THROW(writer.addMask(frames_[1].index, refused), std::invalid_argument);
+        // The writer stops, keeping the frames before whole: the refused mask's frame goes with it.
+        EXPECT_TRUE(writer.stopped());
+        const Recording recorded = Recording::open(other / "rec");
+        ASSERT_EQ(recorded.frames().size(), 1u);
+        EXPECT_EQ(recorded.frames()[0].index, frames_[0].index);
+    }
 }
 
 TEST_F(RecordingTest, RejectsMissingMaskFile) {

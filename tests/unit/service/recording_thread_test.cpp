@@ -117,13 +117,22 @@ TEST_F(RecordingThreadTest, SeveralEncodersWriteEachFramesOwnImageInTheOrderThey
     }
 }
 
-TEST_F(RecordingThreadTest, AMaskTheWriterWouldRefuseIsRefusedWhenAdded) {
+TEST_F(RecordingThreadTest, AMaskTheWriterRefusesStopsTheRecordingAndKeepsTheFramesBefore) {
     io::RecordingWriter writer(dir_ / "rec", rig_, false, true);
-    RecordingThread recording(writer, 2, QueueOverflow::Block, images_, onStop_);
-    const cv::Mat wrongSize(rig_.calibration.cameraSize.height + 1, rig_.calibration.cameraSize.width,
-                            CV_8UC1, cv::Scalar(0));
-    EXPECT_THROW(recording.add(noiseFrame(0, rig_.calibration.cameraSize), std::nullopt, wrongSize),
-                 std::invalid_argument);
+    {
+        RecordingThread recording(writer, 2, QueueOverflow::Block, images_, onStop_);
+        const cv::Mat good(rig_.calibration.cameraSize, CV_8UC1, cv::Scalar(0));
+        const cv::Mat wrongSize(rig_.calibration.cameraSize.height + 1, rig_.calibration.cameraSize.width,
+                                CV_8UC1, cv::Scalar(0));
+        recording.add(noiseFrame(0, rig_.calibration.cameraSize), std::nullopt, good);
+        recording.add(noiseFrame(1, rig_.calibration.cameraSize), std::nullopt, wrongSize);
+        recording.add(noiseFrame(2, rig_.calibration.cameraSize), std::nullopt, good);
+        recording.finish();
+    }
+    EXPECT_EQ(stops_, 1);
+    const io::Recording recorded = io::Recording::open(dir_ / "rec");
+    ASSERT_EQ(recorded.frames().size(), 1u);
+    EXPECT_EQ(recorded.frames()[0].index, 0u);
     EXPECT_THROW(RecordingThread(writer, 2, QueueOverflow::Block, images_, onStop_, 0),
                  std::invalid_argument);
 }
