@@ -233,11 +233,17 @@ std::optional<core::Frame> AravisSource::read(cv::Mat spare) {
         if (!buffer)
             continue;
         const std::uint64_t frameId = arv_buffer_get_frame_id(buffer);
+        // An incomplete buffer may not describe an image at all: its geometry is asked only of a whole one.
+        const bool received = arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS &&
+                              arv_buffer_get_n_parts(buffer) > 0 &&
+                              arv_buffer_get_part_data_type(buffer, 0) == ARV_BUFFER_PART_DATA_TYPE_2D_IMAGE;
         std::size_t bytes = 0;
-        const void* data = arv_buffer_get_image_data(buffer, &bytes);
-        const cv::Size size(arv_buffer_get_image_width(buffer), arv_buffer_get_image_height(buffer));
-        const bool complete = arv_buffer_get_status(buffer) == ARV_BUFFER_STATUS_SUCCESS && data != nullptr &&
-                              size.width > 0 && size.height > 0 && bytes >= cameraPixelsBytes(size, pixels_);
+        const void* data = received ? arv_buffer_get_image_data(buffer, &bytes) : nullptr;
+        const cv::Size size =
+            received ? cv::Size(arv_buffer_get_image_width(buffer), arv_buffer_get_image_height(buffer))
+                     : cv::Size();
+        const bool complete =
+            data != nullptr && size.width > 0 && size.height > 0 && bytes >= cameraPixelsBytes(size, pixels_);
         // Frames lost on the way keep their places in the indices, so that the polarity stays with the count.
         const std::uint64_t missed =
             (lastFrameId_ ? framesMissedBetween(*lastFrameId_, frameId) : 0) + (complete ? 0 : 1);

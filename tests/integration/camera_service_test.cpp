@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <fstream>
 #include <memory>
@@ -225,6 +226,8 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
 struct TouchDown {
     std::uint64_t index = 0;
     double x = 0.0, y = 0.0;
+    // The first entry after it in which nothing touches, if the log has one.
+    std::optional<std::uint64_t> liftIndex;
 };
 
 // The last entry of a touch log, parsed.
@@ -237,19 +240,34 @@ nlohmann::json lastEntry(const std::filesystem::path& log) {
     return nlohmann::json::parse(last, nullptr, false);
 }
 
+bool touches(const nlohmann::json& entry) {
+    for (const nlohmann::json& contact : entry["contacts"])
+        if (contact.value("touch", false))
+            return true;
+    return false;
+}
+
 std::optional<TouchDown> firstTouchDown(const std::filesystem::path& log) {
     std::ifstream in(log);
     std::string line;
+    std::optional<TouchDown> touchDown;
     while (std::getline(in, line)) {
         const nlohmann::json entry = nlohmann::json::parse(line, nullptr, false);
         if (entry.is_discarded() || !entry.contains("contacts"))
             continue;
-        for (const nlohmann::json& contact : entry["contacts"])
-            if (contact.value("touch", false))
-                return TouchDown{entry["index"].get<std::uint64_t>(), contact["x"].get<double>(),
-                                 contact["y"].get<double>()};
+        if (touchDown && !touches(entry)) {
+            touchDown->liftIndex = entry["index"].get<std::uint64_t>();
+            break;
+        }
+        if (!touchDown)
+            for (const nlohmann::json& contact : entry["contacts"])
+                if (contact.value("touch", false)) {
+                    touchDown = TouchDown{entry["index"].get<std::uint64_t>(), contact["x"].get<double>(),
+                                          contact["y"].get<double>(), std::nullopt};
+                    break;
+                }
     }
-    return std::nullopt;
+    return touchDown;
 }
 
 TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
@@ -288,7 +306,9 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
         std::this_thread::sleep_for(100ms);
     ASSERT_TRUE(touchDown) << "no touch in the touch log; StateReason " << get("StateReason");
     EXPECT_EQ(get("State"), "s \"running\"\n");
-    const std::string dropped = get("DroppedFrames");
+    const std::string droppedReply = get("DroppedFrames");
+    unsigned long long dropped = 0;
+    ASSERT_EQ(std::sscanf(droppedReply.c_str(), "t %llu", &dropped), 1) << droppedReply;
 
     // The cable pulled while the finger touches (the tap lasts 46 frames, 2.3 s): the camera is lost within
     // half a second, the finger released, and the daemon waits for the camera. (Stopping then takes some
@@ -313,7 +333,17 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
     RecordProperty("touch_down_frame", std::to_string(touchDown->index));
     RecordProperty("touch_down_offset_px",
                    std::to_string(std::hypot(touchDown->x - expected->x, touchDown->y - expected->y)));
-    EXPECT_EQ(kFirstSimulatedFrame + touchDown->index, expected->index) << "DroppedFrames " << dropped;
+    RecordProperty("dropped_frames", std::to_string(dropped));
+    if (dropped == 0) {
+        EXPECT_EQ(kFirstSimulatedFrame + touchDown->index, expected->index);
+    } else {
+        // Frames lost on the way (a loaded machine drops GVSP packets on the loopback) take pairs from the
+        // evidence the touch adds up: it comes later, but within the tap, where the finger rests.
+        ASSERT_TRUE(expected->liftIndex);
+        EXPECT_GE(kFirstSimulatedFrame + touchDown->index, expected->index) << "DroppedFrames " << dropped;
+        EXPECT_LT(kFirstSimulatedFrame + touchDown->index, *expected->liftIndex)
+            << "DroppedFrames " << dropped;
+    }
     EXPECT_NEAR(touchDown->x, expected->x, 1.0) << "DroppedFrames " << dropped;
     EXPECT_NEAR(touchDown->y, expected->y, 1.0) << "DroppedFrames " << dropped;
 
