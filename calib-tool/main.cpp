@@ -50,6 +50,8 @@ std::string describe(const std::string& name, const calib::PropertyValue& value)
             return calib::format("%.1f frames/s", *number);
         if (name == bus::kPropertyLatencyMs)
             return calib::format("%.1f ms", *number);
+        if (name == bus::kPropertyCalibrationErrorPx)
+            return std::isnan(*number) ? "not measured yet" : calib::format("%.2f projector px", *number);
         return calib::format("%.1f mm", *number);
     }
     if (const auto* count = std::get_if<std::uint64_t>(&value))
@@ -75,6 +77,7 @@ int status() {
         {bus::kPropertyFrameRate, "Frame rate"},
         {bus::kPropertyLatencyMs, "Latency"},
         {bus::kPropertyDroppedFrames, "Dropped"},
+        {bus::kPropertyCalibrationErrorPx, "Calibration error"},
         {bus::kPropertyDevicePath, "Touch device"},
     };
     for (const auto& [property, label] : rows) {
@@ -83,7 +86,7 @@ int status() {
             continue;
         // A property with nothing to say (no reason while running) takes no line.
         if (const std::string text = describe(property, it->second); !text.empty())
-            std::printf("%-14s %s\n", (std::string(label) + ":").c_str(), text.c_str());
+            std::printf("%-19s %s\n", (std::string(label) + ":").c_str(), text.c_str());
     }
     return calib::kExitOk;
 }

@@ -45,6 +45,8 @@ std::optional<std::string> DetectionOptions::validate() const {
         return "height." + *problem;
     if (auto problem = tracker.validate())
         return "tracker." + *problem;
+    if (auto problem = registration.validate())
+        return "registration." + *problem;
     if (!(fingerWidthMm > 0.0 && fingerWidthMm < 50.0))
         return "fingerWidthMm: must be in (0, 50) mm";
     if (!(visibleSpreadMm >= 0.0 && visibleSpreadMm < 20.0))
@@ -59,6 +61,7 @@ std::optional<std::string> DetectionOptions::validate() const {
 TouchPipeline::TouchPipeline(const DetectionOptions& options)
     : options_(options),
       segmenter_(options.segmentation),
+      registration_(options.registration),
       height_(options.height),
       tracker_(options.tracker),
       remembered_(options.fingertips.maxFingertips),
@@ -88,6 +91,9 @@ void TouchPipeline::adoptRig(const PipelineSettings& settings) {
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
     height_.setRig(calibration, settings.pattern);
     codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
+    registration_.setRig(calibration, settings.pattern, segmenter_.judgedRegion(),
+                         options_.segmentation.cameraBlurPx);
+    result_.calibrationErrorPx.reset();
     codeBlurMeasured_ = false;
     pairsUntilBlurMeasure_ = 0;
     const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
@@ -115,6 +121,7 @@ void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSe
     codeBlurMeasured_ = true;
     segmenter_.setRig(*settings.calibration, settings.pattern, *blur);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
+    registration_.setRig(*settings.calibration, settings.pattern, segmenter_.judgedRegion(), *blur);
 }
 
 const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
@@ -183,6 +190,8 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
         segmentedUs_ = result_.timestampUs;
         segmentationsWithoutFingertips_ = found_.empty() ? segmentationsWithoutFingertips_ + 1 : 0;
     }
+    registration_.update(result_.subtraction, result_.handMask, result_.timestampUs);
+    result_.calibrationErrorPx = registration_.errorPx();
     measureFingertips(ordered, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);

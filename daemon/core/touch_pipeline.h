@@ -16,6 +16,7 @@
 #include "core/frame.h"
 #include "core/hand_segmentation.h"
 #include "core/polarity_lock.h"
+#include "core/registration_check.h"
 #include "core/still_scene.h"
 #include "core/surface_height.h"
 
@@ -38,6 +39,7 @@ struct DetectionOptions {
         fingertips;  // the scale and the pad's drop come from the calibration (rigFingertipOptions)
     HeightOptions height;
     TrackerOptions tracker;
+    RegistrationOptions registration;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
     double fingerWidthMm = 16.0;
     // How much a fingertip's visible height varies from frame to frame on a resting fingertip, one standard
@@ -86,6 +88,9 @@ struct PipelineResult {
     std::uint64_t polaritySwaps = 0;
     std::vector<FingertipObservation> fingertips;
     Contacts contacts;  // tracked, in display pixels
+    // How far the code on the table lies from where the calibration puts it, projector pixels
+    // (core/registration_check.h): from the latest tiles measured; nothing until enough were.
+    std::optional<double> calibrationErrorPx;
 };
 
 // The seam between the frame loop and detection: one call per frame pair on the pipeline thread.
@@ -131,6 +136,7 @@ private:
     bool codeBlurMeasured_ = false;
     int pairsUntilBlurMeasure_ = 0;
     StillScene stillScene_;
+    RegistrationCheck registration_;
     std::int64_t segmentedUs_ = 0;            // the timestamp of the last pair segmented
     int segmentationsWithoutFingertips_ = 0;  // running, up to the last
     SurfaceHeight height_;

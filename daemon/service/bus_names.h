@@ -32,6 +32,7 @@ inline constexpr const char* kPropertyDisplaySizeMm = "DisplaySizeMm";
 inline constexpr const char* kPropertyFrameRate = "FrameRate";
 inline constexpr const char* kPropertyLatencyMs = "LatencyMs";
 inline constexpr const char* kPropertyDroppedFrames = "DroppedFrames";
+inline constexpr const char* kPropertyCalibrationErrorPx = "CalibrationErrorPx";
 inline constexpr const char* kPropertyTouchHeightMm = "TouchHeightMm";
 inline constexpr const char* kPropertyDevicePath = "DevicePath";
 

@@ -102,6 +102,11 @@ int getDroppedFrames(sd_bus*, const char*, const char*, const char*, sd_bus_mess
     return sd_bus_message_append(reply, "t", serviceOf(userdata).daemon().statistics().dropped);
 }
 
+int getCalibrationErrorPx(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply,
+                          void* userdata, sd_bus_error*) noexcept {
+    return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().statistics().calibrationErrorPx);
+}
+
 int getTouchHeightMm(sd_bus*, const char*, const char*, const char*, sd_bus_message* reply, void* userdata,
                      sd_bus_error*) noexcept {
     return sd_bus_message_append(reply, "d", serviceOf(userdata).daemon().touchHeightMm());
@@ -190,6 +195,7 @@ const sd_bus_vtable kVtable[] = {
     SD_BUS_PROPERTY(bus::kPropertyFrameRate, "d", getFrameRate, 0, 0),
     SD_BUS_PROPERTY(bus::kPropertyLatencyMs, "d", getLatencyMs, 0, 0),
     SD_BUS_PROPERTY(bus::kPropertyDroppedFrames, "t", getDroppedFrames, 0, 0),
+    SD_BUS_PROPERTY(bus::kPropertyCalibrationErrorPx, "d", getCalibrationErrorPx, 0, 0),
     SD_BUS_WRITABLE_PROPERTY(bus::kPropertyTouchHeightMm, "d", getTouchHeightMm, setTouchHeightMm, 0,
                              SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE | SD_BUS_VTABLE_UNPRIVILEGED),
     SD_BUS_PROPERTY(bus::kPropertyDevicePath, "s", getDevicePath, 0, SD_BUS_VTABLE_PROPERTY_EMITS_CHANGE),

@@ -301,9 +301,12 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
                        << "the code's sign says which shows O + P";
     }
     const bool changed = detecting_ != result->detecting;
-    if (changed || !result->detecting) {
+    {
         std::lock_guard lock(mutex_);
-        idleReason_ = result->idleReason;
+        if (changed || !result->detecting)
+            idleReason_ = result->idleReason;
+        statistics_.calibrationErrorPx =
+            result->calibrationErrorPx.value_or(std::numeric_limits<double>::quiet_NaN());
     }
     detecting_ = result->detecting;
     if (changed)

@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -32,7 +33,10 @@ struct LoopStatistics {
     std::uint64_t dropped = 0;  // frames the source lost, and frames dropped because the pipeline fell behind
     double frameRate = 0.0;     // camera frames per second over the last second
     double latencyMs = 0.0;  // from a frame's arrival to its contacts reaching the sinks, smoothed over ~1 s
-    double seconds = 0.0;    // wall-clock time since start, or of the whole run once finished
+    // How far the code on the table lies from where the calibration puts it, projector pixels
+    // (core/registration_check.h); NaN until measured.
+    double calibrationErrorPx = std::numeric_limits<double>::quiet_NaN();
+    double seconds = 0.0;  // wall-clock time since start, or of the whole run once finished
     // The detection pipeline's time per pair over the last kPipelineSamples pairs, ms (thread CPU time is not
     // measured: this is wall time on the pipeline thread, what the latency is made of).
     double pipelineMedianMs = 0.0;

@@ -37,6 +37,12 @@ std::optional<std::string> SimParameters::validate() const {
         return "wrong_size: must be a number of seconds >= 0";
     if (!positive(wrongSizeDurationS))
         return "wrong_size_s: must be a positive number of seconds";
+    if (knockS && !nonNegative(*knockS))
+        return "knock: must be a number of seconds >= 0";
+    if (!nonNegative(knockDeg) || knockDeg > 10.0)
+        return "knock_deg: must be a number of degrees from 0 to 10";
+    if (!nonNegative(knockMm) || knockMm > 100.0)
+        return "knock_mm: must be a number of millimetres from 0 to 100";
     if (cameraSize.width < 16 || cameraSize.height < 16)
         return "camera_size: at least 16x16 pixels";
     if (!positive(cameraFocalMm))

@@ -41,6 +41,10 @@ struct SimParameters {
     double stallDurationS = 1.0;
     std::optional<double> wrongSizeS;  // from this session time the frames are the sensor's centre quarter
     double wrongSizeDurationS = 0.5;   // (a region changed by someone else), for this long
+    // --- a knock: the camera moves after the calibration, which stays as it was (as a real rig's does) ---
+    std::optional<double> knockS;  // at this session time the camera turns by knockDeg about an axis through
+    double knockDeg = 0.5;         // its centre and shifts by knockMm, axis and direction random (seeded)
+    double knockMm = 2.0;
 
     // --- geometry ---
     cv::Size cameraSize{648, 488};                         // sensor, pixels

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -87,6 +88,7 @@ double Simulator::ambientLux(double seconds) const {
 
 void Simulator::projectImage(const cv::Mat& projectorImage) {
     renderer_->setProjectorImage(projectorImage);
+    projectorImage_ = projectorImage.clone();
     if (!projectorImage.empty() && !userStartS_)
         userStartS_ = frameSeconds(nextIndex_);
 }
@@ -132,6 +134,46 @@ void Simulator::showContent(const SceneState& scene) {
     shown_ = wanted;
 }
 
+Eigen::Isometry3d Simulator::knockedTableToCamera() const {
+    // The axis and the direction follow from the seed alone: the same knock in every run of the spec.
+    std::mt19937_64 random(mix(parameters_.seed ^ 0x6B6E6F636Bull));
+    std::normal_distribution<double> normal;
+    const auto randomDirection = [&] {
+        Eigen::Vector3d v(normal(random), normal(random), normal(random));
+        return Eigen::Vector3d(v.normalized());
+    };
+    const Eigen::Vector3d axis = randomDirection();
+    const Eigen::Vector3d direction = randomDirection();
+    const Eigen::Isometry3d& before = calibration_.tableToCamera;
+    const Eigen::Vector3d centre = -(before.linear().transpose() * before.translation());
+    // The camera turns about its own centre: its axes turn in the table's frame, its centre moves only by
+    // the shift.
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(parameters_.knockDeg * M_PI / 180.0, axis).toRotationMatrix();
+    Eigen::Isometry3d after = Eigen::Isometry3d::Identity();
+    after.linear() = before.linear() * turn.transpose();
+    after.translation() = -(after.linear() * (centre + parameters_.knockMm * direction));
+    return after;
+}
+
+core::Calibration Simulator::geometryAt(double seconds) const {
+    core::Calibration geometry = calibration_;
+    if (parameters_.knockS && seconds >= *parameters_.knockS)
+        geometry.tableToCamera = knockedTableToCamera();
+    return geometry;
+}
+
+void Simulator::placeCamera(bool knocked) {
+    renderer_ = std::make_unique<Renderer>(
+        parameters_, knocked ? geometryAt(*parameters_.knockS) : calibration_, pattern_);
+    if (!projectorImage_.empty())
+        renderer_->setProjectorImage(projectorImage_);
+    shown_.reset();
+    if (!fixedImage_.empty())
+        showFixedImage();
+    knocked_ = knocked;
+}
+
 double Simulator::travelMm(const SceneState& from, const SceneState& to) {
     if (from.hands.size() != to.hands.size())
         return 0.0;
@@ -151,6 +193,8 @@ double Simulator::travelMm(const SceneState& from, const SceneState& to) {
 void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& truth) {
     const double start = frameSeconds(index);
     const double exposure = exposureMs_ / 1000.0;
+    if (const bool knocked = parameters_.knockS && start >= *parameters_.knockS; knocked != knocked_)
+        placeCamera(knocked);
     // The scene at mid-exposure; hands that move are also rendered at more instants of the exposure, about
     // one per camera pixel they travel, and the image averages them.
     const SceneState middle = sceneAt(start + exposure / 2.0);

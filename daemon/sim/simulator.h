@@ -32,7 +32,12 @@ public:
               const cv::Mat& contentImage = cv::Mat());
 
     const SimParameters& parameters() const { return parameters_; }
+    // The rig's calibration, exact until the camera is knocked; it stays the same after, as a real rig's
+    // does (the camera's image and the truth follow the camera where it is).
     const core::Calibration& calibration() const { return calibration_; }
+    // The rig's true geometry at `seconds` into the session: calibration() before a knock, the camera where
+    // the knock put it after.
+    core::Calibration geometryAt(double seconds) const;
     const cv::Mat& pattern() const { return pattern_; }
     const Scenario& scenario() const { return *scenario_; }
 
@@ -73,6 +78,10 @@ private:
     void showContent(const SceneState& scene);
     // The content image, scaled to the display.
     void showFixedImage();
+    // The renderer of the camera where it stands before the knock or after it.
+    void placeCamera(bool knocked);
+    // The camera's pose after the knock (SimParameters::knockS).
+    Eigen::Isometry3d knockedTableToCamera() const;
     // Largest distance a wrist or fingertip moves between two scenes, mm.
     static double travelMm(const SceneState& from, const SceneState& to);
 
@@ -89,6 +98,8 @@ private:
     std::vector<std::vector<HandPose>> exposureHands_;
     std::uint64_t nextIndex_ = 0;       // the frame after the last one rendered
     std::optional<double> userStartS_;  // stream time of the first projected image
+    cv::Mat projectorImage_;            // shown instead of the content when not empty
+    bool knocked_ = false;              // the renderer sees through the knocked camera
 };
 
 }  // namespace everytouch::sim

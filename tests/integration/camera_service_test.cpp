@@ -159,9 +159,10 @@ TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
     EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent lately";
 
     const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
-    EXPECT_THAT(status.out, HasSubstr("State:         degraded"));
-    EXPECT_THAT(status.out, HasSubstr("Calibrated:    no"));
-    EXPECT_THAT(status.out, HasSubstr("Why:           not calibrated (run everytouch-calib calibrate)\n"));
+    EXPECT_THAT(status.out, HasSubstr("State:              degraded"));
+    EXPECT_THAT(status.out, HasSubstr("Calibrated:         no"));
+    EXPECT_THAT(status.out,
+                HasSubstr("Why:                not calibrated (run everytouch-calib calibrate)\n"));
 
     daemon_->signal(SIGTERM);
     EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <regex>
 #include <set>
@@ -241,12 +243,12 @@ TEST_F(ServiceTest, PropertiesAreReadableByEveryone) {
     }
     const test::ProcessResult status = test::runProcess(concat(kNobody, {EVERYTOUCH_CALIB_PATH, "status"}));
     EXPECT_EQ(status.exitCode, 0) << status.err;
-    EXPECT_THAT(status.out, HasSubstr("State:         running"));
-    EXPECT_THAT(status.out, HasSubstr("Projector:     none: a recording shows what it shows"));
+    EXPECT_THAT(status.out, HasSubstr("State:              running"));
+    EXPECT_THAT(status.out, HasSubstr("Projector:          none: a recording shows what it shows"));
     EXPECT_THAT(status.out, Not(HasSubstr("Why:")));  // nothing to explain
     EXPECT_EQ(get("StateReason"), "s \"\"\n");
-    EXPECT_THAT(status.out, HasSubstr("Calibrated:    yes"));
-    EXPECT_THAT(status.out, HasSubstr("Touch height:  3.0 mm"));
+    EXPECT_THAT(status.out, HasSubstr("Calibrated:         yes"));
+    EXPECT_THAT(status.out, HasSubstr("Touch height:       3.0 mm"));
 }
 
 TEST_F(ServiceTest, StatisticsFollowTheCamera) {
@@ -263,6 +265,36 @@ TEST_F(ServiceTest, StatisticsFollowTheCamera) {
     EXPECT_THAT(get("DroppedFrames"), HasSubstr("t "));
 }
 
+// CalibrationErrorPx once it reads a number, or NaN when it never did within the start timeout.
+double measuredCalibrationError(const std::function<std::string()>& read) {
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+        double value = std::numeric_limits<double>::quiet_NaN();
+        if (std::sscanf(read().c_str(), "d %lf", &value) == 1 && std::isfinite(value))
+            return value;
+        std::this_thread::sleep_for(50ms);
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+}
+
+TEST_F(ServiceTest, CalibrationErrorIsAFractionOfAPixelWhileTheCalibrationHolds) {
+    startDaemonOn("sim:grid35");
+    const double error = measuredCalibrationError([&] { return get("CalibrationErrorPx"); });
+    ASSERT_TRUE(std::isfinite(error)) << "CalibrationErrorPx was never measured";
+    EXPECT_LT(error, 0.2);
+    const test::ProcessResult status = test::runProcess({EVERYTOUCH_CALIB_PATH, "status"});
+    EXPECT_THAT(status.out, HasSubstr("Calibration error:  0."));
+    EXPECT_THAT(status.out, HasSubstr(" projector px\n"));
+}
+
+TEST_F(ServiceTest, CalibrationErrorShowsACameraKnockedAfterTheCalibration) {
+    // Half a degree and 2 mm (the simulator's knock), with the calibration from before.
+    startDaemonOn("sim:grid35,knock=0");
+    const double error = measuredCalibrationError([&] { return get("CalibrationErrorPx"); });
+    ASSERT_TRUE(std::isfinite(error)) << "CalibrationErrorPx was never measured";
+    EXPECT_GT(error, 2.0);
+}
+
 TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
     startDaemon();
     const test::ProcessResult result = test::runProcess(busctl(
@@ -275,6 +307,7 @@ TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
          R"(<arg type=\"d\" name=\"rms_px\"/>)",
          R"(<property name=\"FrameRate\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
          R"(<property name=\"DisplaySizeMm\" type=\"(dd)\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
+         R"(<property name=\"CalibrationErrorPx\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
          R"(<property name=\"TouchHeightMm\" type=\"d\" access=\"readwrite\">)"})
         EXPECT_THAT(result.out, HasSubstr(expected));
 }

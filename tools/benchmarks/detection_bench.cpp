@@ -16,6 +16,7 @@
 #include "core/fingertips.h"
 #include "core/hand_segmentation.h"
 #include "core/polarity_lock.h"
+#include "core/registration_check.h"
 #include "core/surface_height.h"
 #include "core/touch_pipeline.h"
 #include "sim/simulator.h"
@@ -223,6 +224,31 @@ void BM_CodeBlur(benchmark::State& state) {
     state.counters["blur_px"] = blur;
 }
 BENCHMARK(BM_CodeBlur)->Unit(benchmark::kMillisecond);
+
+// The calibration's check: one tile of the table per pair (the hand's tiles passed over), as the pipeline
+// runs it.
+void BM_RegistrationCheck(benchmark::State& state) {
+    cv::setNumThreads(1);
+    const Scene& scene = oneHand();
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::RegistrationCheck registration;
+    registration.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion(), 0.5);
+    cv::Mat subtraction, texture, mask;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    segmenter.segment(texture, subtraction, mask);
+    Timings timings;
+    std::int64_t timestampUs = 0;
+    for (auto _ : state) {
+        const auto start = Clock::now();
+        registration.update(subtraction, mask, ++timestampUs);
+        timings.add(Clock::now() - start);
+    }
+    timings.report(state);
+    state.counters["tiles"] = registration.tileCount();
+    state.counters["error_px"] = registration.errorPx().value_or(-1.0);
+}
+BENCHMARK(BM_RegistrationCheck)->Unit(benchmark::kMicrosecond);
 
 void runPipeline(benchmark::State& state, const Scene& scene) {
     cv::setNumThreads(1);

@@ -1,0 +1,93 @@
+// The simulated camera knocked after the calibration: what moves and what stays.
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include <gtest/gtest.h>
+
+#include "sim/sim_options.h"
+#include "sim/simulator.h"
+
+namespace everytouch::sim {
+namespace {
+
+SimParameters knockedRig(double knockS) {
+    SimParameters parameters;
+    parameters.scenario = "idle";
+    parameters.knockS = knockS;
+    return parameters;
+}
+
+Eigen::Vector3d centreOf(const Eigen::Isometry3d& tableToDevice) {
+    return -(tableToDevice.linear().transpose() * tableToDevice.translation());
+}
+
+TEST(SimKnock, TurnsAndShiftsTheCameraByTheSpecsAmountsAndLeavesTheCalibration) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockDeg = 0.8;
+    parameters.knockMm = 3.0;
+    const Simulator simulator(parameters, rigPattern(parameters));
+    const core::Calibration before = simulator.geometryAt(0.99);
+    const core::Calibration after = simulator.geometryAt(1.0);
+    EXPECT_TRUE(before.tableToCamera.isApprox(simulator.calibration().tableToCamera));
+    const double turnedDeg =
+        Eigen::AngleAxisd(after.tableToCamera.linear() * before.tableToCamera.linear().transpose()).angle() *
+        180.0 / M_PI;
+    EXPECT_NEAR(turnedDeg, 0.8, 1e-9);
+    EXPECT_NEAR((centreOf(after.tableToCamera) - centreOf(before.tableToCamera)).norm(), 3.0, 1e-9);
+    EXPECT_TRUE(after.tableToProjector.isApprox(before.tableToProjector));
+    EXPECT_TRUE(after.cameraMatrix.isApprox(before.cameraMatrix));
+}
+
+TEST(SimKnock, TheSameSeedKnocksTheSameWayAnotherSeedAnother) {
+    SimParameters parameters = knockedRig(0.0);
+    const Simulator first(parameters, rigPattern(parameters)), again(parameters, rigPattern(parameters));
+    EXPECT_TRUE(first.geometryAt(0.0).tableToCamera.isApprox(again.geometryAt(0.0).tableToCamera));
+    parameters.seed = 2;
+    const Simulator other(parameters, rigPattern(parameters));
+    EXPECT_FALSE(other.geometryAt(0.0).tableToCamera.isApprox(first.geometryAt(0.0).tableToCamera, 1e-6));
+}
+
+TEST(SimKnock, FramesAfterTheKnockShowTheTableFromWhereTheCameraNowIs) {
+    const SimParameters parameters = knockedRig(0.05);
+    Simulator simulator(parameters, rigPattern(parameters));
+    SimParameters still = parameters;
+    still.knockS.reset();
+    Simulator unknocked(still, rigPattern(still));
+    core::Frame frame, reference;
+    FrameTruth truth;
+    // Frames 0 and 2 come before the knock, 8 after it (120 frames/s), each compared with the same frame of
+    // the rig that was not knocked; frame 0 again after frame 8 is the frame before the knock again.
+    const auto differs = [&](std::uint64_t index) {
+        simulator.render(index, frame, truth);
+        unknocked.render(index, reference, truth);
+        return cv::norm(frame.image, reference.image, cv::NORM_L1) / static_cast<double>(frame.image.total());
+    };
+    EXPECT_EQ(differs(0), 0.0);
+    EXPECT_EQ(differs(2), 0.0);
+    EXPECT_GT(differs(8), 1.0);  // mean DN per pixel: the table's print and light in other places
+    EXPECT_EQ(differs(0), 0.0);
+}
+
+TEST(SimKnock, SpecKeysAreReadAndChecked) {
+    SimParameters p;
+    EXPECT_EQ(applyOption(p, "knock", "12.5"), std::nullopt);
+    EXPECT_EQ(applyOption(p, "knock_deg", "1"), std::nullopt);
+    EXPECT_EQ(applyOption(p, "knock_mm", "0"), std::nullopt);
+    EXPECT_EQ(p.knockS, 12.5);
+    EXPECT_EQ(p.knockDeg, 1.0);
+    EXPECT_EQ(p.knockMm, 0.0);
+    EXPECT_EQ(p.validate(), std::nullopt);
+    p.knockS = -1.0;
+    EXPECT_NE(p.validate().value_or("").find("knock:"), std::string::npos);
+    p = SimParameters();
+    p.knockDeg = 45.0;
+    EXPECT_NE(p.validate().value_or("").find("knock_deg"), std::string::npos);
+    p = SimParameters();
+    p.knockMm = -2.0;
+    EXPECT_NE(p.validate().value_or("").find("knock_mm"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace everytouch::sim
