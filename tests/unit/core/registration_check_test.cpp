@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "core/camera_model.h"
+#include "core/camera_relocation.h"
 #include "core/code_image.h"
 #include "core/geometry.h"
 #include "core/hand_segmentation.h"
@@ -24,6 +25,10 @@ struct Checked {
     std::vector<TileShift> tiles;
     double trueErrorPx = 0.0;  // the median over those tiles of the true misregistration, projector pixels
     double handCover = 0.0;    // the largest share of a tile measured that the hand covered
+    Calibration calibration;   // the rig's, from before any knock
+    Calibration real;          // the rig's true geometry at the last pair
+    cv::Mat pattern;
+    cv::Mat region;
 };
 
 // Runs the check over `pairs` pairs of grid35 from frame 60 on (a hand reaches over the table), with the
@@ -65,6 +70,10 @@ Checked check(sim::SimParameters parameters, int pairs, const RegistrationOption
     // What the code really does at each tile: the camera pixel sees the table point the true camera puts
     // there, which the projector lights from its own pixel; the calibration expects another.
     const Calibration real = simulator.geometryAt(simulator.frameSeconds(first + 2 * pairs));
+    checked.calibration = calibration;
+    checked.real = real;
+    checked.pattern = simulator.pattern();
+    checked.region = segmenter.judgedRegion().clone();
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     std::vector<double> trueLengths;
     for (const TileShift& tile : checked.tiles) {
@@ -115,6 +124,64 @@ TEST(RegistrationCheck, SaysNothingBeforeEnoughTilesWereMeasured) {
     const Checked checked = check(sim::SimParameters{}, 8, options);
     EXPECT_FALSE(checked.errorPx);
     EXPECT_LE(checked.tiles.size(), 8u);
+}
+
+double turnDegrees(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+    return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * 180.0 / M_PI;
+}
+
+Eigen::Vector3d centreOf(const Eigen::Isometry3d& tableToDevice) {
+    return -(tableToDevice.linear().transpose() * tableToDevice.translation());
+}
+
+TEST(CameraRelocation, FindsWhereTheKnockPutTheCameraAndTheCodeFitsAgain) {
+    sim::SimParameters parameters;
+    parameters.knockS = 0.0;
+    const Checked checked = check(parameters, 24);
+    const Result<CameraRelocation> relocated = relocateCamera(checked.calibration, checked.tiles);
+    ASSERT_TRUE(relocated.ok()) << relocated.failure().message;
+    const double turnedDeg = turnDegrees(relocated->tableToCamera, checked.real.tableToCamera);
+    const double movedMm = (centreOf(relocated->tableToCamera) - centreOf(checked.real.tableToCamera)).norm();
+    RecordProperty("residual_px", std::to_string(relocated->residualPx));
+    RecordProperty("turn_left_deg", std::to_string(turnedDeg));
+    RecordProperty("shift_left_mm", std::to_string(movedMm));
+    EXPECT_LT(relocated->residualPx, 0.2);
+    EXPECT_LT(turnedDeg, 0.1);  // of the knock's 0.5
+    EXPECT_LT(movedMm, 5.0);
+
+    // The corrected calibration predicts the code where the knocked camera sees it: the check reads a
+    // fraction of a pixel again.
+    Calibration corrected = checked.calibration;
+    corrected.tableToCamera = relocated->tableToCamera;
+    RegistrationCheck registration;
+    registration.setRig(corrected, checked.pattern, checked.region, 0.5);
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    Frame frames[2];
+    sim::FrameTruth truth;
+    cv::Mat subtraction, texture;
+    for (int i = 0; i < 24; ++i) {
+        for (int k = 0; k < 2; ++k)
+            simulator.render(60 + 2 * i + k, frames[k], truth);
+        computeSubtractionAndTexture(FramePair{frames[0], frames[1]}, subtraction, texture);
+        registration.update(subtraction, truth.handMask, frames[1].timestampUs);
+    }
+    ASSERT_TRUE(registration.errorPx());
+    RecordProperty("error_after_px", std::to_string(*registration.errorPx()));
+    EXPECT_LT(*registration.errorPx(), 0.2);
+}
+
+TEST(CameraRelocation, RefusesTooFewTilesOrTilesInOneCorner) {
+    const Checked checked = check(sim::SimParameters{}, 24);
+    std::vector<TileShift> few(checked.tiles.begin(), checked.tiles.begin() + 5);
+    const Result<CameraRelocation> fromFew = relocateCamera(checked.calibration, few);
+    ASSERT_FALSE(fromFew.ok());
+    EXPECT_NE(fromFew.failure().message.find("5 tiles"), std::string::npos) << fromFew.failure().message;
+    std::vector<TileShift> corner(10, checked.tiles.front());
+    for (std::size_t i = 0; i < corner.size(); ++i)
+        corner[i].centre += Eigen::Vector2d(3.0 * i, 2.0 * i);
+    const Result<CameraRelocation> fromCorner = relocateCamera(checked.calibration, corner);
+    ASSERT_FALSE(fromCorner.ok());
+    EXPECT_NE(fromCorner.failure().message.find("too little of the table"), std::string::npos);
 }
 
 TEST(RegistrationOptions, ValidateNamesTheField) {
