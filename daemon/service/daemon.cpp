@@ -662,6 +662,10 @@ void Daemon::shutDown() {
                          ? "; the frames' order was swapped " + std::to_string(statistics.polaritySwaps) +
                                " times by the code's sign"
                          : std::string());
+    if (std::isfinite(statistics.mostCalibrationErrorPx))
+        ET_LOG(Info) << "the code lay at most " << formatDouble("%.2f", statistics.mostCalibrationErrorPx)
+                     << " projector px from where the calibration puts it, "
+                     << formatDouble("%.2f", statistics.calibrationErrorPx) << " px at the end";
     if (!statistics.recordingStopped.empty()) {
         // Detection went on to the end, but what was asked for is not all there.
         ET_LOG(Error) << options_.recordDir.string() << " is incomplete: " << statistics.recordingStopped;

@@ -307,6 +307,9 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
             idleReason_ = result->idleReason;
         statistics_.calibrationErrorPx =
             result->calibrationErrorPx.value_or(std::numeric_limits<double>::quiet_NaN());
+        if (result->calibrationErrorPx &&
+            !(*result->calibrationErrorPx <= statistics_.mostCalibrationErrorPx))
+            statistics_.mostCalibrationErrorPx = *result->calibrationErrorPx;
     }
     detecting_ = result->detecting;
     if (changed)

@@ -36,6 +36,7 @@ struct LoopStatistics {
     // How far the code on the table lies from where the calibration puts it, projector pixels
     // (core/registration_check.h); NaN until measured.
     double calibrationErrorPx = std::numeric_limits<double>::quiet_NaN();
+    double mostCalibrationErrorPx = std::numeric_limits<double>::quiet_NaN();  // the largest so far
     double seconds = 0.0;  // wall-clock time since start, or of the whole run once finished
     // The detection pipeline's time per pair over the last kPipelineSamples pairs, ms (thread CPU time is not
     // measured: this is wall time on the pipeline thread, what the latency is made of).
