@@ -20,48 +20,85 @@
 namespace everytouch::core {
 namespace {
 
+// Pairs of grid35 from frame 60 on (a hand reaches over the table): S and the hand's true mask, with the
+// rig's calibration and its true geometry. The rigs of 24 pairs are rendered once for the tests that
+// share them.
+struct Rendered {
+    std::vector<cv::Mat> subtractions, handMasks;
+    std::vector<std::int64_t> timestampsUs;
+    Calibration calibration;  // the rig's, from before any knock
+    Calibration real;         // the rig's true geometry over these pairs
+    cv::Mat pattern;
+    cv::Mat region;  // the segmentation's judged region
+};
+
+constexpr int kRenderedPairs = 24;
+
+Rendered render(bool knocked, int pairs) {
+    sim::SimParameters parameters;
+    parameters.scenario = "grid35";
+    if (knocked)
+        parameters.knockS = 0.0;
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    Rendered rendered;
+    rendered.calibration = simulator.calibration();
+    rendered.pattern = simulator.pattern();
+    HandSegmenter segmenter{SegmentationOptions{}};
+    segmenter.setRig(rendered.calibration, rendered.pattern);
+    rendered.region = segmenter.judgedRegion().clone();
+    Frame frames[2];
+    sim::FrameTruth truth;
+    cv::Mat texture;
+    const std::uint64_t first = 60;
+    for (int i = 0; i < pairs; ++i) {
+        for (int k = 0; k < 2; ++k)
+            simulator.render(first + 2 * i + k, frames[k], truth);
+        computeSubtractionAndTexture(FramePair{frames[0], frames[1]}, rendered.subtractions.emplace_back(),
+                                     texture);
+        rendered.handMasks.push_back(truth.handMask.clone());
+        rendered.timestampsUs.push_back(frames[1].timestampUs);
+    }
+    rendered.real = simulator.geometryAt(simulator.frameSeconds(first + 2 * pairs));
+    return rendered;
+}
+
+const Rendered& calibratedRig() {
+    static const Rendered rendered = render(false, kRenderedPairs);
+    return rendered;
+}
+
+const Rendered& knockedRig() {
+    static const Rendered rendered = render(true, kRenderedPairs);
+    return rendered;
+}
+
 struct Checked {
     std::optional<double> errorPx;
     std::vector<TileShift> tiles;
     double trueErrorPx = 0.0;  // the median over those tiles of the true misregistration, projector pixels
     double handCover = 0.0;    // the largest share of a tile measured that the hand covered
-    Calibration calibration;   // the rig's, from before any knock
-    Calibration real;          // the rig's true geometry at the last pair
-    cv::Mat pattern;
-    cv::Mat region;
 };
 
-// Runs the check over `pairs` pairs of grid35 from frame 60 on (a hand reaches over the table), with the
-// hand's true mask.
-Checked check(sim::SimParameters parameters, int pairs, const RegistrationOptions& options = {}) {
-    parameters.scenario = "grid35";
-    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    const Calibration& calibration = simulator.calibration();
-    HandSegmenter segmenter{SegmentationOptions{}};
-    segmenter.setRig(calibration, simulator.pattern());
+// Runs the check over the first `pairs` pairs, with `calibration` (the rig's when not given).
+Checked check(const Rendered& rendered, int pairs, const RegistrationOptions& options = {},
+              const std::optional<Calibration>& calibration = std::nullopt) {
+    const Calibration& used = calibration ? *calibration : rendered.calibration;
     RegistrationCheck registration(options);
-    registration.setRig(calibration, simulator.pattern(), segmenter.judgedRegion(), 0.5);
+    registration.setRig(used, rendered.pattern, rendered.region, 0.5);
     EXPECT_TRUE(registration.hasRig());
-
     Checked checked;
-    Frame frames[2];
-    sim::FrameTruth truth;
-    cv::Mat subtraction, texture;
-    const std::uint64_t first = 60;
     for (int i = 0; i < pairs; ++i) {
-        for (int k = 0; k < 2; ++k)
-            simulator.render(first + 2 * i + k, frames[k], truth);
-        computeSubtractionAndTexture(FramePair{frames[0], frames[1]}, subtraction, texture);
-        registration.update(subtraction, truth.handMask, frames[1].timestampUs);
+        const cv::Mat& handMask = rendered.handMasks[i];
+        registration.update(rendered.subtractions[i], handMask, rendered.timestampsUs[i]);
         for (const TileShift& tile : registration.latest())
-            if (tile.timestampUs == frames[1].timestampUs) {
+            if (tile.timestampUs == rendered.timestampsUs[i]) {
                 const int reach = RegistrationOptions{}.tilePx / 2;
                 const cv::Rect window(cv::Point(static_cast<int>(tile.centre.x()) - reach,
                                                 static_cast<int>(tile.centre.y()) - reach),
                                       cv::Size(2 * reach, 2 * reach));
-                const cv::Rect inside = window & cv::Rect({0, 0}, truth.handMask.size());
-                checked.handCover = std::max(
-                    checked.handCover, cv::countNonZero(truth.handMask(inside)) / double(inside.area()));
+                const cv::Rect inside = window & cv::Rect({0, 0}, handMask.size());
+                checked.handCover =
+                    std::max(checked.handCover, cv::countNonZero(handMask(inside)) / double(inside.area()));
             }
     }
     checked.errorPx = registration.errorPx();
@@ -69,17 +106,12 @@ Checked check(sim::SimParameters parameters, int pairs, const RegistrationOption
 
     // What the code really does at each tile: the camera pixel sees the table point the true camera puts
     // there, which the projector lights from its own pixel; the calibration expects another.
-    const Calibration real = simulator.geometryAt(simulator.frameSeconds(first + 2 * pairs));
-    checked.calibration = calibration;
-    checked.real = real;
-    checked.pattern = simulator.pattern();
-    checked.region = segmenter.judgedRegion().clone();
-    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    const CameraModel camera{used.cameraMatrix, used.cameraDistortion};
     std::vector<double> trueLengths;
     for (const TileShift& tile : checked.tiles) {
         const Eigen::Vector2d pixel = camera.undistortPixel(tile.centre);
-        const Eigen::Vector2d expected = applyHomography(calibration.cameraToProjectorHomography(), pixel);
-        const Eigen::Vector2d seen = applyHomography(real.cameraToProjectorHomography(), pixel);
+        const Eigen::Vector2d expected = applyHomography(used.cameraToProjectorHomography(), pixel);
+        const Eigen::Vector2d seen = applyHomography(rendered.real.cameraToProjectorHomography(), pixel);
         trueLengths.push_back((seen - expected).norm());
     }
     if (!trueLengths.empty()) {
@@ -91,7 +123,7 @@ Checked check(sim::SimParameters parameters, int pairs, const RegistrationOption
 }
 
 TEST(RegistrationCheck, ACalibrationThatHoldsShowsAFewHundredthsOfAPixel) {
-    const Checked checked = check(sim::SimParameters{}, 24);
+    const Checked checked = check(calibratedRig(), kRenderedPairs);
     ASSERT_TRUE(checked.errorPx);
     RecordProperty("error_px", std::to_string(*checked.errorPx));
     EXPECT_LT(*checked.errorPx, 0.1);
@@ -102,9 +134,7 @@ TEST(RegistrationCheck, ACalibrationThatHoldsShowsAFewHundredthsOfAPixel) {
 }
 
 TEST(RegistrationCheck, AKnockedCameraShowsTheMisregistrationItMade) {
-    sim::SimParameters parameters;
-    parameters.knockS = 0.0;
-    const Checked checked = check(parameters, 24);
+    const Checked checked = check(knockedRig(), kRenderedPairs);
     ASSERT_TRUE(checked.errorPx);
     RecordProperty("error_px", std::to_string(*checked.errorPx));
     RecordProperty("true_error_px", std::to_string(checked.trueErrorPx));
@@ -114,14 +144,14 @@ TEST(RegistrationCheck, AKnockedCameraShowsTheMisregistrationItMade) {
 }
 
 TEST(RegistrationCheck, PassesOverTilesTheHandCovers) {
-    const Checked checked = check(sim::SimParameters{}, 24);
+    const Checked checked = check(calibratedRig(), kRenderedPairs);
     EXPECT_EQ(checked.handCover, 0.0);
 }
 
 TEST(RegistrationCheck, SaysNothingBeforeEnoughTilesWereMeasured) {
     RegistrationOptions options;
     options.tilesPerEstimate = 16;
-    const Checked checked = check(sim::SimParameters{}, 8, options);
+    const Checked checked = check(render(false, 8), 8, options);
     EXPECT_FALSE(checked.errorPx);
     EXPECT_LE(checked.tiles.size(), 8u);
 }
@@ -135,13 +165,12 @@ Eigen::Vector3d centreOf(const Eigen::Isometry3d& tableToDevice) {
 }
 
 TEST(CameraRelocation, FindsWhereTheKnockPutTheCameraAndTheCodeFitsAgain) {
-    sim::SimParameters parameters;
-    parameters.knockS = 0.0;
-    const Checked checked = check(parameters, 24);
-    const Result<CameraRelocation> relocated = relocateCamera(checked.calibration, checked.tiles);
+    const Rendered& rig = knockedRig();
+    const Checked checked = check(rig, kRenderedPairs);
+    const Result<CameraRelocation> relocated = relocateCamera(rig.calibration, checked.tiles);
     ASSERT_TRUE(relocated.ok()) << relocated.failure().message;
-    const double turnedDeg = turnDegrees(relocated->tableToCamera, checked.real.tableToCamera);
-    const double movedMm = (centreOf(relocated->tableToCamera) - centreOf(checked.real.tableToCamera)).norm();
+    const double turnedDeg = turnDegrees(relocated->tableToCamera, rig.real.tableToCamera);
+    const double movedMm = (centreOf(relocated->tableToCamera) - centreOf(rig.real.tableToCamera)).norm();
     RecordProperty("residual_px", std::to_string(relocated->residualPx));
     RecordProperty("turn_left_deg", std::to_string(turnedDeg));
     RecordProperty("shift_left_mm", std::to_string(movedMm));
@@ -151,35 +180,25 @@ TEST(CameraRelocation, FindsWhereTheKnockPutTheCameraAndTheCodeFitsAgain) {
 
     // The corrected calibration predicts the code where the knocked camera sees it: the check reads a
     // fraction of a pixel again.
-    Calibration corrected = checked.calibration;
+    Calibration corrected = rig.calibration;
     corrected.tableToCamera = relocated->tableToCamera;
-    RegistrationCheck registration;
-    registration.setRig(corrected, checked.pattern, checked.region, 0.5);
-    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    Frame frames[2];
-    sim::FrameTruth truth;
-    cv::Mat subtraction, texture;
-    for (int i = 0; i < 24; ++i) {
-        for (int k = 0; k < 2; ++k)
-            simulator.render(60 + 2 * i + k, frames[k], truth);
-        computeSubtractionAndTexture(FramePair{frames[0], frames[1]}, subtraction, texture);
-        registration.update(subtraction, truth.handMask, frames[1].timestampUs);
-    }
-    ASSERT_TRUE(registration.errorPx());
-    RecordProperty("error_after_px", std::to_string(*registration.errorPx()));
-    EXPECT_LT(*registration.errorPx(), 0.2);
+    const Checked again = check(rig, kRenderedPairs, {}, corrected);
+    ASSERT_TRUE(again.errorPx);
+    RecordProperty("error_after_px", std::to_string(*again.errorPx));
+    EXPECT_LT(*again.errorPx, 0.2);
 }
 
 TEST(CameraRelocation, RefusesTooFewTilesOrTilesInOneCorner) {
-    const Checked checked = check(sim::SimParameters{}, 24);
+    const Rendered& rig = calibratedRig();
+    const Checked checked = check(rig, kRenderedPairs);
     std::vector<TileShift> few(checked.tiles.begin(), checked.tiles.begin() + 5);
-    const Result<CameraRelocation> fromFew = relocateCamera(checked.calibration, few);
+    const Result<CameraRelocation> fromFew = relocateCamera(rig.calibration, few);
     ASSERT_FALSE(fromFew.ok());
     EXPECT_NE(fromFew.failure().message.find("5 tiles"), std::string::npos) << fromFew.failure().message;
     std::vector<TileShift> corner(10, checked.tiles.front());
     for (std::size_t i = 0; i < corner.size(); ++i)
         corner[i].centre += Eigen::Vector2d(3.0 * i, 2.0 * i);
-    const Result<CameraRelocation> fromCorner = relocateCamera(checked.calibration, corner);
+    const Result<CameraRelocation> fromCorner = relocateCamera(rig.calibration, corner);
     ASSERT_FALSE(fromCorner.ok());
     EXPECT_NE(fromCorner.failure().message.find("too little of the table"), std::string::npos);
 }
