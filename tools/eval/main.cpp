@@ -168,6 +168,7 @@ struct TouchArguments {
     std::size_t frames = 0;
     std::string json;
     std::string png;
+    std::string trace;
     // The match radius, mm: half a finger width (an adult index finger is about 16 mm across), the distance
     // from a finger's contact point to the middle between it and a neighbour resting beside it.
     double matchRadiusMm = 8.0;
@@ -204,6 +205,10 @@ CLI::App* addTouchCommand(CLI::App& app, TouchArguments& arguments) {
     command->add_option("--json", arguments.json, "Also write the results as JSON to FILE");
     command->add_option("--png", arguments.png,
                         "Plot true (green) and detected (red) touch-down points over the display");
+    command->add_option(
+        "--trace", arguments.trace,
+        "Write one CSV row per true finger and frame: its truth and the contact matched to it "
+        "(id, height, touching, position)");
     command
         ->add_option("--match-radius-mm", arguments.matchRadiusMm,
                      "How far a contact may lie from a true contact point and still be that finger")
@@ -257,6 +262,12 @@ int reportTouches(const TouchArguments& arguments, const std::string& sourceName
         out << eval::touchJson(source, score).dump(2) << '\n';
         if (!out)
             throw std::runtime_error(arguments.json + ": cannot be written");
+    }
+    if (!arguments.trace.empty()) {
+        std::ofstream out(arguments.trace);
+        eval::writeTouchTrace(out, truth, detected, options.matchRadiusPx);
+        if (!out)
+            throw std::runtime_error(arguments.trace + ": cannot be written");
     }
     if (!arguments.png.empty() &&
         !cv::imwrite(arguments.png, eval::plotTouchDowns(score, rig.calibration.displaySize)))

@@ -1,5 +1,6 @@
 #include "eval/touch_report.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "eval/optional_json.h"
@@ -119,6 +120,30 @@ std::string touchTable(const TouchSource& source, const TouchScore& score) {
                      count(score.hoverBandErrorMm[b].count) + " finger frames");
     }
     return text;
+}
+
+void writeTouchTrace(std::ostream& out, const TruthFrames& truth, const DetectedFrames& detected,
+                     double radiusPx) {
+    out << "position,finger,truth_height_mm,truth_x,truth_y,contact_id,height_mm,touching,x,y\n";
+    char row[160];
+    const std::size_t frames = std::min(truth.size(), detected.size());
+    for (std::size_t p = 0; p < frames; ++p) {
+        const std::vector<int> matched = matchFrame(truth[p], detected[p], radiusPx);
+        for (std::size_t f = 0; f < truth[p].size(); ++f) {
+            const core::FingerTruth& finger = truth[p][f];
+            std::snprintf(row, sizeof row, "%zu,%u,%.2f,%.2f,%.2f,", p, finger.id, finger.heightMm, finger.x,
+                          finger.y);
+            out << row;
+            if (matched[f] < 0) {
+                out << ",,,,\n";
+                continue;
+            }
+            const core::Contact& contact = detected[p][static_cast<std::size_t>(matched[f])];
+            std::snprintf(row, sizeof row, "%u,%.2f,%d,%.2f,%.2f\n", contact.id, contact.heightMm,
+                          contact.touching ? 1 : 0, contact.x, contact.y);
+            out << row;
+        }
+    }
 }
 
 }  // namespace everytouch::eval

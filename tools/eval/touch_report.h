@@ -1,5 +1,6 @@
 #pragma once
 
+#include <ostream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -21,5 +22,11 @@ nlohmann::json touchJson(const TouchSource& source, const TouchScore& score);
 
 // The score as the table printed to the terminal.
 std::string touchTable(const TouchSource& source, const TouchScore& score);
+
+// One CSV row per true finger and frame: the finger's truth and the contact matched to it as the score
+// matches them (empty fields where none lies within radiusPx), to study heights and touch states frame by
+// frame (a hovering finger's readings before a false touch-down, say).
+void writeTouchTrace(std::ostream& out, const TruthFrames& truth, const DetectedFrames& detected,
+                     double radiusPx);
 
 }  // namespace everytouch::eval

@@ -16,30 +16,6 @@ Eigen::Vector2d pointOf(const core::Contact& contact) {
     return {contact.x, contact.y};
 }
 
-// The contact matched to each true finger of a frame (index into the frame's contacts), one to one, nearest
-// pairs first; -1 where none lies within the radius.
-std::vector<int> matchFrame(const std::vector<core::FingerTruth>& fingers, const core::Contacts& contacts,
-                            double radiusPx) {
-    std::vector<std::tuple<double, std::size_t, std::size_t>> candidates;
-    for (std::size_t f = 0; f < fingers.size(); ++f)
-        for (std::size_t c = 0; c < contacts.size(); ++c) {
-            if (contacts[c].palm)
-                continue;
-            const double distance = (pointOf(fingers[f]) - pointOf(contacts[c])).norm();
-            if (distance <= radiusPx)
-                candidates.emplace_back(distance, f, c);
-        }
-    std::sort(candidates.begin(), candidates.end());
-    std::vector<int> matched(fingers.size(), -1);
-    std::vector<bool> taken(contacts.size(), false);
-    for (const auto& [distance, f, c] : candidates)
-        if (matched[f] < 0 && !taken[c]) {
-            matched[f] = static_cast<int>(c);
-            taken[c] = true;
-        }
-    return matched;
-}
-
 double distanceToSegment(const Eigen::Vector2d& point, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     const Eigen::Vector2d ab = b - a;
     const double length2 = ab.squaredNorm();
@@ -62,6 +38,28 @@ bool wasTouching(const core::Contacts& contacts, std::uint32_t id) {
 }
 
 }  // namespace
+
+std::vector<int> matchFrame(const std::vector<core::FingerTruth>& fingers, const core::Contacts& contacts,
+                            double radiusPx) {
+    std::vector<std::tuple<double, std::size_t, std::size_t>> candidates;
+    for (std::size_t f = 0; f < fingers.size(); ++f)
+        for (std::size_t c = 0; c < contacts.size(); ++c) {
+            if (contacts[c].palm)
+                continue;
+            const double distance = (pointOf(fingers[f]) - pointOf(contacts[c])).norm();
+            if (distance <= radiusPx)
+                candidates.emplace_back(distance, f, c);
+        }
+    std::sort(candidates.begin(), candidates.end());
+    std::vector<int> matched(fingers.size(), -1);
+    std::vector<bool> taken(contacts.size(), false);
+    for (const auto& [distance, f, c] : candidates)
+        if (matched[f] < 0 && !taken[c]) {
+            matched[f] = static_cast<int>(c);
+            taken[c] = true;
+        }
+    return matched;
+}
 
 std::optional<std::string> TouchScoringOptions::validate() const {
     if (!(matchRadiusPx > 0.0) || !std::isfinite(matchRadiusPx))

@@ -89,6 +89,11 @@ struct TouchScore {
     std::optional<double> far() const;  // phantom touch-downs / true trials
 };
 
+// The contact matched to each true finger of a frame (index into the frame's contacts), one to one, nearest
+// pairs first, palms left out; -1 where none lies within the radius.
+std::vector<int> matchFrame(const std::vector<core::FingerTruth>& fingers, const core::Contacts& contacts,
+                            double radiusPx);
+
 // Scores a detector's contacts against the truth, frame by frame. In each frame the true fingers and the
 // detected contacts (palms left out) are matched one to one, the nearest pairs first, within the radius.
 TouchScore scoreTouches(const TruthFrames& truth, const DetectedFrames& detected,

@@ -1,6 +1,10 @@
 #include "eval/touch_scoring.h"
 
+#include <sstream>
+
 #include <gtest/gtest.h>
+
+#include "eval/touch_report.h"
 
 #include "support/test_rig.h"
 
@@ -197,6 +201,18 @@ TEST(ScoreTouches, EachContactServesOneFinger) {
     const TouchScore score = scoreTouches(truth, detected, options());
     EXPECT_EQ(score.rejected(), 1);
     EXPECT_TRUE(score.trials[1].found);
+}
+
+TEST(TouchTrace, GivesEachFingerItsMatchedContactOrEmptyFields) {
+    TruthFrames truth = {{finger(1, 100, 100, 4), finger(2, 300, 100, 0)}, {finger(1, 100, 100, 0)}};
+    DetectedFrames detected = {{contact(7, 103, 104, true, 1.5), contact(8, 500, 100, true)}, {}};
+    std::ostringstream out;
+    writeTouchTrace(out, truth, detected, kRadiusPx);
+    EXPECT_EQ(out.str(),
+              "position,finger,truth_height_mm,truth_x,truth_y,contact_id,height_mm,touching,x,y\n"
+              "0,1,4.00,100.00,100.00,7,1.50,1,103.00,104.00\n"
+              "0,2,0.00,300.00,100.00,,,,,\n"
+              "1,1,0.00,100.00,100.00,,,,,\n");
 }
 
 TEST(MatchRadius, ConvertsMillimetresWithTheDisplaysScale) {
