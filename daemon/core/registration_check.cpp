@@ -70,6 +70,7 @@ void RegistrationCheck::setRig(const Calibration& calibration, const cv::Mat& pa
     CV_Assert(region.type() == CV_8UC1 && region.size() == calibration.cameraSize);
     tiles_.clear();
     latest_.clear();
+    measured_ = 0;
     next_ = 0;
 
     // The search's reach in camera pixels, from the table's scale at the display's centre.
@@ -273,6 +274,7 @@ void RegistrationCheck::update(const cv::Mat& subtraction, const cv::Mat& handMa
         if (latest_.size() == static_cast<std::size_t>(options_.tilesPerEstimate))
             latest_.erase(latest_.begin());
         latest_.push_back(*shift);
+        ++measured_;
     }
 }
 

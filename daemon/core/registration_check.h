@@ -76,6 +76,8 @@ public:
     std::optional<double> errorPx() const;
     // The latest tiles measured, oldest first, at most tilesPerEstimate.
     const std::vector<TileShift>& latest() const { return latest_; }
+    // Tiles measured since the rig was set.
+    std::uint64_t measured() const { return measured_; }
 
 private:
     struct Tile {
@@ -101,6 +103,7 @@ private:
     std::size_t next_ = 0;  // the tile the round goes on with
     std::size_t stride_ = 1;
     std::vector<TileShift> latest_;
+    std::uint64_t measured_ = 0;
     // Scratch, sized by setRig: the reach's window of S and its local mean, its sparse phases, the
     // sparse tile and the correlations of a refinement.
     cv::Mat window_, rowSums_;  // S over the reach; the local mean's sums along its rows

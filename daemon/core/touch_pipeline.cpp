@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "core/camera_model.h"
+#include "core/camera_relocation.h"
 #include "core/code_image.h"
 #include "core/fill.h"
 #include "core/geometry.h"
@@ -47,6 +48,11 @@ std::optional<std::string> DetectionOptions::validate() const {
         return "tracker." + *problem;
     if (auto problem = registration.validate())
         return "registration." + *problem;
+    if (auto problem = correction.validate())
+        return "correction." + *problem;
+    if (correctCalibration && registration.tilesPerEstimate < kMinRelocationTiles)
+        return "registration.tilesPerEstimate: the calibration's correction needs at least " +
+               std::to_string(kMinRelocationTiles) + " tiles";
     if (!(fingerWidthMm > 0.0 && fingerWidthMm < 50.0))
         return "fingerWidthMm: must be in (0, 50) mm";
     if (!(visibleSpreadMm >= 0.0 && visibleSpreadMm < 20.0))
@@ -62,6 +68,7 @@ TouchPipeline::TouchPipeline(const DetectionOptions& options)
     : options_(options),
       segmenter_(options.segmentation),
       registration_(options.registration),
+      corrector_(options.correction),
       height_(options.height),
       tracker_(options.tracker),
       remembered_(options.fingertips.maxFingertips),
@@ -84,29 +91,60 @@ void TouchPipeline::reset() {
 
 void TouchPipeline::adoptRig(const PipelineSettings& settings) {
     const Calibration& calibration = *settings.calibration;
-    if (rigCalibration_ && sameCalibration(*rigCalibration_, calibration) &&
-        rigPattern_.data == settings.pattern.data && rigPattern_.size() == settings.pattern.size())
+    const bool samePattern =
+        rigPattern_.data == settings.pattern.data && rigPattern_.size() == settings.pattern.size();
+    if (samePattern && rigCalibration_ && sameCalibration(*rigCalibration_, calibration))
         return;
+    // The settings still hold the calibration this pipeline corrected: it goes on with its correction.
+    if (samePattern && correctedFrom_ && sameCalibration(*correctedFrom_, calibration))
+        return;
+    correctedFrom_.reset();
     segmenter_.setRig(calibration, settings.pattern);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
     height_.setRig(calibration, settings.pattern);
     codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
     registration_.setRig(calibration, settings.pattern, segmenter_.judgedRegion(),
                          options_.segmentation.cameraBlurPx);
+    corrector_.setRig(calibration, options_.registration.tilesPerEstimate);
     result_.calibrationErrorPx.reset();
+    result_.calibrationProblem.clear();
     codeBlurMeasured_ = false;
+    codeBlurPx_.reset();
     pairsUntilBlurMeasure_ = 0;
+    prepareFingertips(calibration);
+    const cv::Size2d displayMm = calibration.displaySizeMm();
+    displayPixelsPerMm_ = calibration.displaySize.width / displayMm.width;
+    rigCalibration_ = calibration;
+    rigPattern_ = settings.pattern;
+    reset();
+}
+
+void TouchPipeline::prepareFingertips(const Calibration& calibration) {
     const FingertipOptions rig = rigFingertipOptions(calibration, options_.fingerWidthMm);
     options_.fingertips.fingerWidthPx = rig.fingerWidthPx;
     options_.fingertips.padDrop = rig.padDrop;
     // Blocks a quarter of a finger wide: a fingertip that moves changes several of them.
     stillScene_.setRegion(segmenter_.displayBox(),
                           std::clamp(static_cast<int>(std::lround(rig.fingerWidthPx / 4.0)), 2, 64));
-    const cv::Size2d displayMm = calibration.displaySizeMm();
-    displayPixelsPerMm_ = calibration.displaySize.width / displayMm.width;
+}
+
+void TouchPipeline::adoptCorrection(const CalibrationCorrection& correction,
+                                    const PipelineSettings& settings) {
+    if (!correctedFrom_)
+        correctedFrom_ = *settings.calibration;
+    const Calibration& calibration = correction.calibration;
+    segmenter_.setRig(calibration, settings.pattern, codeBlurPx_);
+    polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
+    height_.setRig(calibration, settings.pattern);
+    if (!codeBlurMeasured_)
+        codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
+    registration_.setRig(calibration, settings.pattern, segmenter_.judgedRegion(),
+                         codeBlurPx_.value_or(options_.segmentation.cameraBlurPx));
+    prepareFingertips(calibration);
     rigCalibration_ = calibration;
-    rigPattern_ = settings.pattern;
-    reset();
+    // The fingertips' evidence was gathered through the old geometry; the tracks and contacts go on.
+    rememberedCount_ = 0;
+    result_.correction = correction;
 }
 
 void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings) {
@@ -119,9 +157,10 @@ void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSe
     }
     // Once: a rig's focus does not change while it runs, and a new calibration measures it again.
     codeBlurMeasured_ = true;
-    segmenter_.setRig(*settings.calibration, settings.pattern, *blur);
+    codeBlurPx_ = *blur;
+    segmenter_.setRig(*rigCalibration_, settings.pattern, *blur);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
-    registration_.setRig(*settings.calibration, settings.pattern, segmenter_.judgedRegion(), *blur);
+    registration_.setRig(*rigCalibration_, settings.pattern, segmenter_.judgedRegion(), *blur);
 }
 
 const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
@@ -192,6 +231,14 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     }
     registration_.update(result_.subtraction, result_.handMask, result_.timestampUs);
     result_.calibrationErrorPx = registration_.errorPx();
+    result_.correction.reset();
+    if (options_.correctCalibration) {
+        if (std::optional<CalibrationCorrection> correction =
+                corrector_.update(registration_.measured(), registration_.latest()))
+            adoptCorrection(*correction, settings);
+        if (result_.calibrationProblem != corrector_.problem())
+            result_.calibrationProblem = corrector_.problem();
+    }
     measureFingertips(ordered, settings);
     tracker_.update(result_.timestampUs, observations_, settings.touchHeightMm, displayPixelsPerMm_,
                     result_.contacts);
@@ -199,7 +246,7 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
 }
 
 void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSettings& settings) {
-    const Calibration& calibration = *settings.calibration;
+    const Calibration& calibration = *rigCalibration_;
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
     result_.fingertips.clear();
     observations_.clear();

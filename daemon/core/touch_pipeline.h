@@ -9,6 +9,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include "core/calibration.h"
+#include "core/calibration_correction.h"
 #include "core/code_blur.h"
 #include "core/contact.h"
 #include "core/contact_tracker.h"
@@ -40,6 +41,10 @@ struct DetectionOptions {
     HeightOptions height;
     TrackerOptions tracker;
     RegistrationOptions registration;
+    // Whether a calibration the code shows to be off, because the camera moved, is corrected while detection
+    // runs (core/calibration_correction.h), and how.
+    bool correctCalibration = true;
+    CorrectionOptions correction;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
     double fingerWidthMm = 16.0;
     // How much a fingertip's visible height varies from frame to frame on a resting fingertip, one standard
@@ -91,6 +96,11 @@ struct PipelineResult {
     // How far the code on the table lies from where the calibration puts it, projector pixels
     // (core/registration_check.h): from the latest tiles measured; nothing until enough were.
     std::optional<double> calibrationErrorPx;
+    // Set in the pair after which the pipeline works with a corrected calibration (the camera moved): it goes
+    // on with it, contacts and all, for as long as its settings hold the calibration it corrected.
+    std::optional<CalibrationCorrection> correction;
+    // Why a calibration the code shows to be off was not corrected; empty otherwise.
+    std::string calibrationProblem;
 };
 
 // The seam between the frame loop and detection: one call per frame pair on the pipeline thread.
@@ -124,6 +134,10 @@ private:
     };
 
     void adoptRig(const PipelineSettings& settings);
+    // Goes on with `correction`'s calibration from the next pair: every stage that predicts the code is
+    // prepared for it, while the tracks, their contacts and the code's blur stay.
+    void adoptCorrection(const CalibrationCorrection& correction, const PipelineSettings& settings);
+    void prepareFingertips(const Calibration& calibration);
     void measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings);
     void measureFingertips(const FramePair& pair, const PipelineSettings& settings);
 
@@ -137,6 +151,8 @@ private:
     int pairsUntilBlurMeasure_ = 0;
     StillScene stillScene_;
     RegistrationCheck registration_;
+    CalibrationCorrector corrector_;
+    std::optional<double> codeBlurPx_;        // as measured on this rig
     std::int64_t segmentedUs_ = 0;            // the timestamp of the last pair segmented
     int segmentationsWithoutFingertips_ = 0;  // running, up to the last
     SurfaceHeight height_;
@@ -144,6 +160,8 @@ private:
     FingertipScratch fingertipScratch_;
     Fingertips found_;
     std::optional<Calibration> rigCalibration_;  // the calibration the stages were prepared for
+    // The settings' calibration that rigCalibration_ corrects, while one does.
+    std::optional<Calibration> correctedFrom_;
     cv::Mat rigPattern_;
     double displayPixelsPerMm_ = 1.0;
     HeightEvidence frameEvidence_;

@@ -47,6 +47,7 @@ inline constexpr const char* kMethodSnapshot = "Snapshot";
 inline constexpr const char* kSignalContacts = "Contacts";
 inline constexpr const char* kSignalCalibrationProgress = "CalibrationProgress";
 inline constexpr const char* kSignalCalibrationFinished = "CalibrationFinished";
+inline constexpr const char* kSignalCalibrationCorrected = "CalibrationCorrected";
 
 // The keys of Calibrate's options dictionary.
 inline constexpr const char* kOptionFrames = "frames";

@@ -214,6 +214,8 @@ const sd_bus_vtable kVtable[] = {
                             SD_BUS_ARGS("s", step, "d", fraction, "s", message), 0),
     SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalCalibrationFinished, SD_BUS_ARGS("b", ok, "s", message, "d", rms_px),
                             0),
+    SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalCalibrationCorrected,
+                            SD_BUS_ARGS("d", before_px, "d", after_px, "s", what), 0),
     SD_BUS_VTABLE_END,
 };
 
@@ -307,6 +309,14 @@ void BusService::calibrationFinished(bool ok, const std::string& message, double
                            "bsd", static_cast<int>(ok), message.c_str(), rmsPx);
     if (r < 0)
         ET_LOG(Warning) << "cannot send CalibrationFinished: " << std::strerror(-r);
+}
+
+void BusService::calibrationCorrected(double beforePx, double afterPx, const std::string& what) {
+    const int r =
+        sd_bus_emit_signal(bus_.get(), bus::kObjectPath, bus::kInterface, bus::kSignalCalibrationCorrected,
+                           "dds", beforePx, afterPx, what.c_str());
+    if (r < 0)
+        ET_LOG(Warning) << "cannot send CalibrationCorrected: " << std::strerror(-r);
 }
 
 void BusService::reply(sd_bus_message* call) {

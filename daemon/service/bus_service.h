@@ -29,6 +29,7 @@ public:
     void contacts(const core::Contacts& contacts);
     void calibrationProgress(const std::string& step, double fraction, const std::string& message);
     void calibrationFinished(bool ok, const std::string& message, double rmsPx);
+    void calibrationCorrected(double beforePx, double afterPx, const std::string& what);
 
     // Answers a method call the daemon kept for later.
     void reply(sd_bus_message* call);

@@ -1,7 +1,11 @@
 #include "service/calibration_store.h"
 
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
+#include <system_error>
 
+#include "io/atomic_file.h"
 #include "io/calibration_file.h"
 #include "io/input_error.h"
 
@@ -34,6 +38,20 @@ void CalibrationStore::save() const {
     if (!active_)
         throw std::logic_error("there is no calibration to save");
     io::writeCalibrationFile(path_, *active_);
+}
+
+void CalibrationStore::saveKeepingBackup() const {
+    if (path_.empty())
+        throw std::logic_error("no calibration file is configured");
+    std::error_code error;
+    if (std::filesystem::exists(path_, error)) {
+        std::ifstream in(path_, std::ios::binary);
+        const std::string kept{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        if (!in && !in.eof())
+            throw std::system_error(errno, std::generic_category(), path_.string() + ": cannot be read");
+        io::writeFileAtomically(backupPath(), kept);
+    }
+    save();
 }
 
 }  // namespace everytouch::service

@@ -33,6 +33,10 @@ public:
     // Writes the active calibration atomically. Throws std::logic_error when there is no file or nothing is
     // active, std::system_error or io::InputError when writing fails (the old file stays intact).
     void save() const;
+    // As save(), after copying the file there (if any) to path() + ".bak", atomically too: a correction the
+    // daemon made on its own can be undone by hand.
+    void saveKeepingBackup() const;
+    std::filesystem::path backupPath() const { return path_.string() + ".bak"; }
 
 private:
     std::filesystem::path path_;

@@ -371,6 +371,9 @@ DaemonState Daemon::state() const {
     if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing() || loop_->sourceLost() ||
         loop_->idle())
         return DaemonState::Degraded;
+    // Detection goes on, but its touches land beside the fingers until someone calibrates.
+    if (!loop_->calibrationProblem().empty())
+        return DaemonState::Degraded;
     return DaemonState::Running;
 }
 
@@ -385,6 +388,10 @@ std::string Daemon::stateReason() const {
                 return "not detecting (the projected code is not known: set [Projector] Output=window for "
                        "the daemon's own projector window, or external for a projector that embeds it, see "
                        "everytouchd.conf(5))";
+            if (const std::string problem = loop_ ? loop_->calibrationProblem() : std::string();
+                !problem.empty() && !loop_->idle() && !loop_->failing())
+                return "the calibration no longer fits: " + problem +
+                       "; touches may land beside the fingers until \"everytouch-calib calibrate table\"";
             return "not detecting (" + (loop_ ? loop_->idleReason() : std::string("no frames yet")) + ")";
         case DaemonState::Failed:
             return loop_ ? loop_->failure().value_or("") : std::string();
@@ -477,8 +484,37 @@ void Daemon::onLoopNews() {
         sd_event_exit(event_.get(), exitStatus_);
         return;
     }
+    if (std::optional<core::CalibrationCorrection> correction = loop_->takeCorrection())
+        adoptCorrection(*correction);
     refreshState();  // detection may have started or stopped
     emitContacts();
+}
+
+void Daemon::adoptCorrection(const core::CalibrationCorrection& correction) {
+    // A calibration made or reset since the pipeline corrected the one it had is newer than the correction.
+    const std::optional<core::Calibration>& active = store_->active();
+    if (calibration_ || !active || active->cameraMatrix != correction.calibration.cameraMatrix ||
+        !active->tableToProjector.isApprox(correction.calibration.tableToProjector) ||
+        active->displayToProjector != correction.calibration.displayToProjector)
+        return;
+    store_->activate(correction.calibration);
+    applySettings();
+    std::string kept = "; it is active, not saved (this rig keeps no calibration file)";
+    if (store_->keepsFile()) {
+        try {
+            store_->saveKeepingBackup();
+            kept = "; saved to " + store_->path().string() + ", the previous file kept as " +
+                   store_->backupPath().string();
+        } catch (const std::exception& error) {
+            kept = std::string("; it is active, but could not be saved: ") + error.what();
+        }
+    }
+    ET_LOG(Notice) << "calibration corrected: the " << correction.what << " moved; the code lay "
+                   << formatDouble("%.2f", correction.beforePx) << " projector px from where the calibration "
+                   << "put it, " << formatDouble("%.2f", correction.afterPx) << " px now ("
+                   << correction.tiles << " tiles)" << kept;
+    if (bus_)
+        bus_->calibrationCorrected(correction.beforePx, correction.afterPx, correction.what);
 }
 
 void Daemon::emitContacts() {
@@ -590,9 +626,17 @@ void Daemon::saveCalibration() {
 void Daemon::resetCalibration() {
     if (calibration_)
         throw BusError(bus::kErrorBusy, "A calibration is running; wait for its CalibrationFinished signal");
-    store_->forget();
+    if (const std::optional<std::string> problem = store_->load())
+        ET_LOG(Error) << *problem << "; running uncalibrated";
     applySettings();
-    ET_LOG(Notice) << "calibration forgotten; the stored file, if any, is left as it is";
+    if (store_->active()) {
+        drawDisplayThrough(*store_->active());
+        ET_LOG(Notice) << "calibration reset to the one "
+                       << (store_->keepsFile() ? "saved in " + store_->path().string()
+                                               : std::string("the rig brings"));
+    } else {
+        ET_LOG(Notice) << "calibration reset: none is saved, so everytouchd is not calibrated";
+    }
     refreshState();
 }
 

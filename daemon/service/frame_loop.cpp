@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <utility>
 
 #include "io/log.h"
 #include "io/thread_name.h"
@@ -179,6 +180,16 @@ std::chrono::steady_clock::time_point FrameLoop::heartbeat() const {
     return Clock::time_point(Clock::duration(heartbeatNs_.load()));
 }
 
+std::optional<core::CalibrationCorrection> FrameLoop::takeCorrection() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(correction_, std::nullopt);
+}
+
+std::string FrameLoop::calibrationProblem() const {
+    std::lock_guard lock(mutex_);
+    return calibrationProblem_;
+}
+
 void FrameLoop::setSettings(core::PipelineSettings settings) {
     std::lock_guard lock(mutex_);
     settings_ = std::move(settings);
@@ -310,6 +321,19 @@ void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSet
         if (result->calibrationErrorPx &&
             !(*result->calibrationErrorPx <= statistics_.mostCalibrationErrorPx))
             statistics_.mostCalibrationErrorPx = *result->calibrationErrorPx;
+    }
+    if (result->correction || result->calibrationProblem != calibrationProblemSeen_) {
+        if (result->calibrationProblem != calibrationProblemSeen_ && !result->calibrationProblem.empty())
+            ET_LOG(Warning) << "calibration: " << result->calibrationProblem
+                            << "; run \"everytouch-calib calibrate table\"";
+        calibrationProblemSeen_ = result->calibrationProblem;
+        {
+            std::lock_guard lock(mutex_);
+            if (result->correction)
+                correction_ = result->correction;
+            calibrationProblem_ = calibrationProblemSeen_;
+        }
+        notify_();
     }
     detecting_ = result->detecting;
     if (changed)

@@ -105,6 +105,10 @@ public:
     std::chrono::steady_clock::time_point heartbeat() const;
 
     void setSettings(core::PipelineSettings settings);
+    // The pipeline's latest correction of the calibration (core/calibration_correction.h) not taken yet.
+    std::optional<core::CalibrationCorrection> takeCorrection();
+    // Why the pipeline found the calibration off and did not correct it; empty otherwise.
+    std::string calibrationProblem() const;
     // Whether detection ran on the last pair (calibrated, the code known, no failure, frames coming); why
     // not, when not.
     bool detecting() const { return detecting_; }
@@ -153,7 +157,8 @@ private:
     std::atomic<bool> detecting_{false};
     std::atomic<bool> judged_{false};
     std::atomic<bool> failingNow_{false};
-    std::uint64_t polaritySwaps_ = 0;  // as the pipeline last reported them (pipeline thread)
+    std::uint64_t polaritySwaps_ = 0;     // as the pipeline last reported them (pipeline thread)
+    std::string calibrationProblemSeen_;  // as the pipeline last reported it (pipeline thread)
     std::atomic<std::int64_t> heartbeatNs_{0};
     std::thread camera_;
     std::thread pipelineThread_;
@@ -170,6 +175,8 @@ private:
     core::PipelineSettings settings_;
     std::uint64_t settingsVersion_ = 0;
     std::string idleReason_;
+    std::optional<core::CalibrationCorrection> correction_;
+    std::string calibrationProblem_;
     // The last pipeline times (ms) in a ring, preallocated: recording one allocates nothing.
     std::vector<double> pipelineMs_;
     std::size_t pipelineSamples_ = 0;

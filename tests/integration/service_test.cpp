@@ -287,12 +287,70 @@ TEST_F(ServiceTest, CalibrationErrorIsAFractionOfAPixelWhileTheCalibrationHolds)
     EXPECT_THAT(status.out, HasSubstr(" projector px\n"));
 }
 
-TEST_F(ServiceTest, CalibrationErrorShowsACameraKnockedAfterTheCalibration) {
-    // Half a degree and 2 mm (the simulator's knock), with the calibration from before.
-    startDaemonOn("sim:grid35,knock=0");
-    const double error = measuredCalibrationError([&] { return get("CalibrationErrorPx"); });
-    ASSERT_TRUE(std::isfinite(error)) << "CalibrationErrorPx was never measured";
-    EXPECT_GT(error, 2.0);
+TEST_F(ServiceTest, ACameraKnockedAfterTheCalibrationIsCorrectedSavedAndAnnounced) {
+    // Half a degree and 2 mm (the simulator's knock) one second in, with the calibration from before in the
+    // calibration file.
+    const core::Calibration before = sim::rigCalibration(sim::SimParameters{});
+    io::writeCalibrationFile(dir_ / "calibration.yml", before);
+    const std::string saved = test::fileContents(dir_ / "calibration.yml");
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus listener(raw);
+    struct Corrected {
+        int signals = 0;
+        double beforePx = 0.0, afterPx = 0.0;
+        std::string what;
+    } corrected;
+    sd_bus_slot* slot = nullptr;
+    ASSERT_GE(sd_bus_match_signal(
+                  listener.get(), &slot, bus::kBusName, bus::kObjectPath, bus::kInterface,
+                  bus::kSignalCalibrationCorrected,
+                  [](sd_bus_message* message, void* userdata, sd_bus_error*) {
+                      auto& seen = *static_cast<Corrected*>(userdata);
+                      const char* what = nullptr;
+                      if (sd_bus_message_read(message, "dds", &seen.beforePx, &seen.afterPx, &what) >= 0) {
+                          seen.what = what;
+                          ++seen.signals;
+                      }
+                      return 0;
+                  },
+                  &corrected),
+              0);
+    const io::BusSlot match(slot);
+    startDaemonOn("sim:grid35,knock=1");
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    while (corrected.signals == 0 && std::chrono::steady_clock::now() < deadline) {
+        if (sd_bus_process(listener.get(), nullptr) == 0)
+            sd_bus_wait(listener.get(), 100'000);
+    }
+    ASSERT_EQ(corrected.signals, 1) << "no CalibrationCorrected";
+    RecordProperty("before_px", std::to_string(corrected.beforePx));
+    RecordProperty("after_px", std::to_string(corrected.afterPx));
+    EXPECT_GT(corrected.beforePx, 2.0);
+    EXPECT_LT(corrected.afterPx, 0.2);
+    EXPECT_EQ(corrected.what, "camera");
+
+    // The check reads a fraction of a pixel again, and the corrected calibration is the one saved, with the
+    // one from before kept beside it.
+    const auto settled = std::chrono::steady_clock::now() + kStartTimeout;
+    double error = std::numeric_limits<double>::quiet_NaN();
+    while (!(error < 0.2) && std::chrono::steady_clock::now() < settled) {
+        error = measuredCalibrationError([&] { return get("CalibrationErrorPx"); });
+        std::this_thread::sleep_for(100ms);
+    }
+    EXPECT_LT(error, 0.2);
+    EXPECT_EQ(test::fileContents(dir_ / "calibration.yml.bak"), saved);
+    const core::Calibration kept = io::readCalibrationFile(dir_ / "calibration.yml");
+    EXPECT_FALSE(kept.tableToCamera.isApprox(before.tableToCamera, 1e-6));
+    EXPECT_TRUE(kept.tableToProjector.isApprox(before.tableToProjector, 1e-9));
+    EXPECT_EQ(get("State"), "s \"running\"\n");
+
+    // ResetCalibration goes back to the saved calibration: the corrected one.
+    const test::ProcessResult reset = test::runProcess(call("ResetCalibration"));
+    ASSERT_EQ(reset.exitCode, 0) << reset.err;
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    EXPECT_THAT(daemon_->output(), HasSubstr("calibration corrected: the camera moved"));
 }
 
 TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
@@ -305,6 +363,7 @@ TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
         {R"(<method name=\"Calibrate\">\n   <arg type=\"s\" name=\"step\" direction=\"in\"/>\n   <arg type=\"a{sv}\" name=\"options\" direction=\"in\"/>)",
          R"(<arg type=\"h\" name=\"fd\" direction=\"in\"/>)", R"(<arg type=\"a(uddbd)\" name=\"contacts\"/>)",
          R"(<arg type=\"d\" name=\"rms_px\"/>)",
+         R"(<signal name=\"CalibrationCorrected\">\n   <arg type=\"d\" name=\"before_px\"/>\n   <arg type=\"d\" name=\"after_px\"/>\n   <arg type=\"s\" name=\"what\"/>)",
          R"(<property name=\"FrameRate\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
          R"(<property name=\"DisplaySizeMm\" type=\"(dd)\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
          R"(<property name=\"CalibrationErrorPx\" type=\"d\" access=\"read\">\n   <annotation name=\"org.freedesktop.DBus.Property.EmitsChangedSignal\" value=\"false\"/>)",
@@ -999,7 +1058,7 @@ TEST_F(ServiceTest, ACorruptCalibrationFileIsReportedAndKept) {
     EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), before);
 }
 
-TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveOne) {
+TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetGoesBackToIt) {
     core::Calibration stored = test::smallRig().calibration;
     stored.displayToProjector(0, 2) = 3.25;
     io::writeCalibrationFile(dir_ / "calibration.yml", stored);
@@ -1015,13 +1074,17 @@ TEST_F(ServiceTest, TheCalibrationFileIsSavedAtomicallyAndResetForgetsTheActiveO
     EXPECT_NE(before.st_ino, after.st_ino) << "not replaced by rename";
     EXPECT_DOUBLE_EQ(io::readCalibrationFile(dir_ / "calibration.yml").displayToProjector(0, 2), 3.25);
 
+    // ResetCalibration goes back to the saved one; with the file gone, to none.
+    result = test::runProcess(call("ResetCalibration"));
+    ASSERT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(get("Calibrated"), "b true\n");
+    std::filesystem::remove(dir_ / "calibration.yml");
     result = test::runProcess(call("ResetCalibration"));
     ASSERT_EQ(result.exitCode, 0) << result.err;
     EXPECT_EQ(get("Calibrated"), "b false\n");
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
     result = test::runProcess(call("SaveCalibration"));
     EXPECT_THAT(result.err, HasSubstr("There is no calibration to save"));
-    EXPECT_TRUE(std::filesystem::exists(dir_ / "calibration.yml"));
 }
 
 TEST_F(ServiceTest, ACalibrationFileTurnedToGarbageWhileRunningChangesNothingUntilSavedAtomically) {

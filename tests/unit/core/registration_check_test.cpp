@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/calibration_correction.h"
 #include "core/camera_model.h"
 #include "core/camera_relocation.h"
 #include "core/code_image.h"
@@ -201,6 +202,88 @@ TEST(CameraRelocation, RefusesTooFewTilesOrTilesInOneCorner) {
     const Result<CameraRelocation> fromCorner = relocateCamera(rig.calibration, corner);
     ASSERT_FALSE(fromCorner.ok());
     EXPECT_NE(fromCorner.failure().message.find("too little of the table"), std::string::npos);
+}
+
+// Runs the check and the corrector pair by pair, as the pipeline does, until the corrector corrects.
+struct Corrected {
+    std::optional<CalibrationCorrection> correction;
+    int pair = -1;  // the pair after which it did
+    std::string problem;
+};
+
+Corrected correct(const Rendered& rendered, int pairs) {
+    RegistrationCheck registration;
+    registration.setRig(rendered.calibration, rendered.pattern, rendered.region, 0.5);
+    CalibrationCorrector corrector;
+    corrector.setRig(rendered.calibration, RegistrationOptions{}.tilesPerEstimate);
+    Corrected corrected;
+    for (int i = 0; i < pairs && !corrected.correction; ++i) {
+        registration.update(rendered.subtractions[i], rendered.handMasks[i], rendered.timestampsUs[i]);
+        corrected.correction = corrector.update(registration.measured(), registration.latest());
+        corrected.pair = i;
+        corrected.problem = corrector.problem();
+    }
+    return corrected;
+}
+
+TEST(CalibrationCorrector, CorrectsAKnockedCameraAndTheCodeFitsAgain) {
+    const Rendered& rig = knockedRig();
+    const Corrected corrected = correct(rig, kRenderedPairs);
+    ASSERT_TRUE(corrected.correction) << corrected.problem;
+    const CalibrationCorrection& correction = *corrected.correction;
+    RecordProperty("pairs", corrected.pair + 1);
+    RecordProperty("before_px", std::to_string(correction.beforePx));
+    RecordProperty("after_px", std::to_string(correction.afterPx));
+    EXPECT_EQ(corrected.pair + 1, RegistrationOptions{}.tilesPerEstimate);  // the first round decides
+    EXPECT_GT(correction.beforePx, 2.0);
+    EXPECT_LT(correction.afterPx, 0.2);
+    EXPECT_EQ(correction.what, "camera");
+    EXPECT_LT(turnDegrees(correction.calibration.tableToCamera, rig.real.tableToCamera), 0.1);
+    // Only the camera's pose changed.
+    EXPECT_TRUE(correction.calibration.tableToProjector.isApprox(rig.calibration.tableToProjector));
+    EXPECT_EQ(correction.calibration.cameraMatrix, rig.calibration.cameraMatrix);
+    const Checked again = check(rig, kRenderedPairs, {}, correction.calibration);
+    ASSERT_TRUE(again.errorPx);
+    EXPECT_LT(*again.errorPx, 0.2);
+}
+
+TEST(CalibrationCorrector, LeavesACalibrationThatHoldsAsItIs) {
+    const Corrected corrected = correct(calibratedRig(), kRenderedPairs);
+    EXPECT_FALSE(corrected.correction);
+    EXPECT_EQ(corrected.problem, "");
+}
+
+TEST(CalibrationCorrector, RefusesAMisregistrationNoMoveOfTheCameraExplains) {
+    const Rendered& rig = calibratedRig();
+    const Checked checked = check(rig, kRenderedPairs);
+    ASSERT_EQ(checked.tiles.size(), 16u);
+    // Each tile's code displaced its own way by a pixel: what a warped table or a creeping, distorting
+    // projector image could show, and no pose of the camera.
+    std::vector<TileShift> scattered = checked.tiles;
+    cv::RNG rng(5);
+    for (TileShift& tile : scattered)
+        tile.cameraPx = Eigen::Vector2d(rng.gaussian(1.5), rng.gaussian(1.5));
+    CalibrationCorrector corrector;
+    corrector.setRig(rig.calibration, 16);
+    EXPECT_FALSE(corrector.update(16, scattered));
+    EXPECT_EQ(corrector.problem(), "") << "told after one round";
+    EXPECT_FALSE(corrector.update(32, scattered));
+    EXPECT_NE(corrector.problem().find("no move of the camera explains it"), std::string::npos)
+        << corrector.problem();
+    // Too few tiles for a round: nothing is judged yet.
+    CalibrationCorrector waiting;
+    waiting.setRig(rig.calibration, 16);
+    EXPECT_FALSE(waiting.update(15, scattered));
+    EXPECT_EQ(waiting.problem(), "");
+}
+
+TEST(CorrectionOptions, ValidateNamesTheField) {
+    CorrectionOptions options;
+    EXPECT_FALSE(options.validate());
+    options.leastErrorPx = 0.0;
+    ASSERT_TRUE(options.validate());
+    EXPECT_NE(options.validate()->find("leastErrorPx"), std::string::npos);
+    EXPECT_THROW(CalibrationCorrector{options}, std::invalid_argument);
 }
 
 TEST(RegistrationOptions, ValidateNamesTheField) {

@@ -166,14 +166,25 @@ TEST(TouchPipelineRendered, AFingerRestingOnTheTableIsNotLostToOnePairsSegmentat
 
 // grid35 from 1.75 s on, a hand over the table, the camera knocked (0.5 degrees, 2 mm) at 2 s: the pipeline's
 // check of the calibration reads a fraction of a pixel before and the knock's misregistration within half a
-// second after it.
-TEST(TouchPipelineRendered, AKnockedCameraIsSeenWithinHalfASecond) {
+// second after it. With the correction, the pipeline then works with the camera's new pose and the check
+// reads a fraction of a pixel again; without it, the misregistration stays.
+struct KnockOutcome {
+    std::optional<double> mostBeforePx;
+    std::optional<double> seenAfterS;
+    std::optional<double> correctedAfterS;
+    std::optional<CalibrationCorrection> correction;
+    std::optional<double> lastPx;  // the check's reading at the end, 0.6 s after the knock
+};
+
+KnockOutcome knockAt2s(bool correct) {
     sim::SimParameters parameters;
     parameters.scenario = "grid35";
     constexpr double kKnockS = 2.0;
     parameters.knockS = kKnockS;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    TouchPipeline pipeline;
+    DetectionOptions options;
+    options.correctCalibration = correct;
+    TouchPipeline pipeline(options);
     const PipelineSettings settings = test::simulatedRigSettings(simulator);
     Frame older, newer;
     sim::FrameTruth truth;
@@ -182,26 +193,53 @@ TEST(TouchPipelineRendered, AKnockedCameraIsSeenWithinHalfASecond) {
     };
     constexpr double kStartS = 1.75;
     simulator.render(frameAt(kStartS), older, truth);
-    std::optional<double> before;
-    std::optional<double> seenAfterS;
+    KnockOutcome outcome;
     for (std::uint64_t index = frameAt(kStartS) + 1; index < frameAt(kKnockS + 0.6); ++index) {
         simulator.render(index, newer, truth);
         const PipelineResult& result = processInOrder(pipeline, older, newer, settings);
         std::swap(older, newer);
         const double seconds = simulator.frameSeconds(index);
+        if (result.correction) {
+            EXPECT_FALSE(outcome.correction) << "corrected twice";
+            outcome.correction = result.correction;
+            outcome.correctedAfterS = seconds - kKnockS;
+        }
+        outcome.lastPx = result.calibrationErrorPx;
         if (!result.calibrationErrorPx)
             continue;
         if (seconds < kKnockS)
-            before = std::max(before.value_or(0.0), *result.calibrationErrorPx);
-        else if (!seenAfterS && *result.calibrationErrorPx > 1.0)
-            seenAfterS = seconds - kKnockS;
+            outcome.mostBeforePx = std::max(outcome.mostBeforePx.value_or(0.0), *result.calibrationErrorPx);
+        else if (!outcome.seenAfterS && *result.calibrationErrorPx > 1.0)
+            outcome.seenAfterS = seconds - kKnockS;
     }
-    ASSERT_TRUE(before) << "nothing was measured before the knock";
-    RecordProperty("most_before_px", std::to_string(*before));
-    EXPECT_LT(*before, 0.2);
-    ASSERT_TRUE(seenAfterS) << "the knock was not seen within 0.6 s";
-    RecordProperty("seen_after_s", std::to_string(*seenAfterS));
-    EXPECT_LT(*seenAfterS, 0.5);
+    return outcome;
+}
+
+TEST(TouchPipelineRendered, AKnockedCameraIsSeenWithinHalfASecondAndCorrected) {
+    const KnockOutcome outcome = knockAt2s(true);
+    ASSERT_TRUE(outcome.mostBeforePx) << "nothing was measured before the knock";
+    RecordProperty("most_before_px", std::to_string(*outcome.mostBeforePx));
+    EXPECT_LT(*outcome.mostBeforePx, 0.2);
+    ASSERT_TRUE(outcome.seenAfterS) << "the knock was not seen within 0.6 s";
+    RecordProperty("seen_after_s", std::to_string(*outcome.seenAfterS));
+    EXPECT_LT(*outcome.seenAfterS, 0.5);
+    ASSERT_TRUE(outcome.correction) << "the knock was not corrected within 0.6 s";
+    RecordProperty("corrected_after_s", std::to_string(*outcome.correctedAfterS));
+    RecordProperty("correction_before_px", std::to_string(outcome.correction->beforePx));
+    RecordProperty("correction_after_px", std::to_string(outcome.correction->afterPx));
+    EXPECT_GT(outcome.correction->beforePx, 1.0);
+    EXPECT_LT(outcome.correction->afterPx, 0.2);
+    ASSERT_TRUE(outcome.lastPx) << "the check read nothing after the correction";
+    RecordProperty("last_px", std::to_string(*outcome.lastPx));
+    EXPECT_LT(*outcome.lastPx, 0.2);
+}
+
+TEST(TouchPipelineRendered, WithoutTheCorrectionAKnockedCameraStaysMisregistered) {
+    const KnockOutcome outcome = knockAt2s(false);
+    EXPECT_TRUE(outcome.seenAfterS);
+    EXPECT_FALSE(outcome.correction);
+    ASSERT_TRUE(outcome.lastPx);
+    EXPECT_GT(*outcome.lastPx, 1.0);
 }
 
 TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {

@@ -1,0 +1,268 @@
+#include "core/calibration_correction.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string_view>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "core/camera_model.h"
+#include "core/camera_relocation.h"
+#include "core/geometry.h"
+
+namespace everytouch::core {
+
+namespace {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix26d = Eigen::Matrix<double, 2, 6>;
+
+// Steps of the numerical derivatives: a microradian turns the table's points by a few thousandths of a camera
+// pixel, a micrometre moves them by less; both far above rounding, far below the curvature of the projection.
+constexpr double kTurnStepRad = 1e-6;
+constexpr double kShiftStepMm = 1e-3;
+// Step of the camera-to-projector map's derivative, camera pixels: the map is smooth over a pixel.
+constexpr double kPixelStep = 0.5;
+// A tile is set aside when the move leaves it this many times the median tile's residual, in at most this
+// many passes: a Gaussian residual's median is 1.18 sigma in two dimensions, so 3.5 medians is 4 sigma.
+constexpr double kOutlierMedians = 3.5;
+constexpr int kOutlierPasses = 2;
+
+// The camera pose moved by `move`: a turn (rotation vector, radians) before the pose's own rotation, then a
+// shift (mm) of the translation.
+Eigen::Isometry3d movedPose(const Eigen::Isometry3d& pose, const Vector6d& move) {
+    Eigen::Isometry3d moved = pose;
+    const Eigen::Vector3d turn = move.head<3>();
+    if (const double angle = turn.norm(); angle > 0.0)
+        moved.linear() = Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() * pose.linear();
+    moved.translation() = pose.translation() + move.tail<3>();
+    return moved;
+}
+
+Eigen::Vector2d seenAt(const CameraModel& camera, const Eigen::Isometry3d& pose,
+                       const Eigen::Vector3d& point) {
+    return camera.project(pose * point);
+}
+
+// What the check measured at one tile, in the terms of a camera pose: the table point the projector lights
+// through the code predicted at the tile's centre, where the camera now sees it, and how camera pixels there
+// map to projector pixels.
+struct TileGeometry {
+    Eigen::Vector3d tablePoint;
+    Eigen::Vector2d observed;
+    Eigen::Matrix2d toProjector;
+};
+
+TileGeometry tileGeometry(const CameraModel& camera, const Eigen::Matrix3d& cameraToProjector,
+                          const Eigen::Matrix3d& projectorToTable, const TileShift& tile) {
+    const auto lit = [&](const Eigen::Vector2d& raw) {
+        return applyHomography(cameraToProjector, camera.undistortPixel(raw));
+    };
+    TileGeometry geometry;
+    const Eigen::Vector2d onTable = applyHomography(projectorToTable, lit(tile.centre));
+    geometry.tablePoint = Eigen::Vector3d(onTable.x(), onTable.y(), 0.0);
+    geometry.observed = tile.centre + tile.cameraPx;
+    const Eigen::Vector2d dx = Eigen::Vector2d(kPixelStep, 0.0), dy = Eigen::Vector2d(0.0, kPixelStep);
+    geometry.toProjector.col(0) = (lit(tile.centre + dx) - lit(tile.centre - dx)) / (2.0 * kPixelStep);
+    geometry.toProjector.col(1) = (lit(tile.centre + dy) - lit(tile.centre - dy)) / (2.0 * kPixelStep);
+    return geometry;
+}
+
+}  // namespace
+
+std::optional<std::string> CorrectionOptions::validate() const {
+    if (!(noiseMultiple >= 1.0 && noiseMultiple <= 100.0))
+        return "noiseMultiple: must be in [1, 100]";
+    if (!(leastErrorPx > 0.0 && leastErrorPx <= 10.0))
+        return "leastErrorPx: must be in (0, 10] projector pixels";
+    return std::nullopt;
+}
+
+CalibrationCorrector::CalibrationCorrector(const CorrectionOptions& options) : options_(options) {
+    if (auto problem = options.validate())
+        throw std::invalid_argument("calibration correction options: " + *problem);
+}
+
+void CalibrationCorrector::setRig(const Calibration& calibration, int tilesPerRound) {
+    if (tilesPerRound < kMinRelocationTiles)
+        throw std::invalid_argument("calibration correction: a round needs at least " +
+                                    std::to_string(kMinRelocationTiles) + " tiles");
+    calibration_ = calibration;
+    tilesPerRound_ = tilesPerRound;
+    terms_.reserve(static_cast<std::size_t>(tilesPerRound));
+    residuals_.reserve(static_cast<std::size_t>(tilesPerRound));
+    inliers_.reserve(static_cast<std::size_t>(tilesPerRound));
+    judged_ = 0;
+    heldNoisePx_.reset();
+    roundsOff_ = 0;
+    problem_.clear();
+}
+
+void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
+    const Calibration& calibration = *calibration_;
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    const Eigen::Matrix3d cameraToProjector = calibration.cameraToProjectorHomography();
+    const Eigen::Matrix3d projectorToTable = calibration.tableToProjectorHomography().inverse();
+    const Eigen::Isometry3d& pose = calibration.tableToCamera;
+    terms_.clear();
+    for (const TileShift& tile : tiles) {
+        const TileGeometry geometry = tileGeometry(camera, cameraToProjector, projectorToTable, tile);
+        const Eigen::Vector2d predicted = seenAt(camera, pose, geometry.tablePoint);
+        Matrix26d derivative;
+        for (int k = 0; k < 6; ++k) {
+            Vector6d move = Vector6d::Zero();
+            move[k] = k < 3 ? kTurnStepRad : kShiftStepMm;
+            derivative.col(k) =
+                (seenAt(camera, movedPose(pose, move), geometry.tablePoint) - predicted) / move[k];
+        }
+        terms_.push_back({geometry.toProjector * derivative,
+                          geometry.toProjector * (geometry.observed - predicted), true, 0.0});
+    }
+}
+
+CalibrationCorrector::Fit CalibrationCorrector::fitMove() {
+    Eigen::Matrix<double, 6, 6> normal = Eigen::Matrix<double, 6, 6>::Zero();
+    Vector6d right = Vector6d::Zero();
+    double squares = 0.0;
+    int used = 0;
+    for (const TileTerm& term : terms_) {
+        if (!term.inlier)
+            continue;
+        normal += term.onPanel.transpose() * term.onPanel;
+        right += term.onPanel.transpose() * term.shift;
+        squares += term.shift.squaredNorm();
+        ++used;
+    }
+    // Turns and shifts differ in scale by the camera's distance, and a far camera's turn and shift nearly
+    // trade for each other: the equations are balanced, and directions the tiles cannot tell apart dropped.
+    const Vector6d scale = normal.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::Matrix<double, 6, 6> balanced = scale.asDiagonal() * normal * scale.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> solver(balanced);
+    const Vector6d along = solver.eigenvectors().transpose() * (scale.asDiagonal() * right);
+    const double largest = solver.eigenvalues().maxCoeff();
+    Vector6d solved = Vector6d::Zero();
+    for (int k = 0; k < 6; ++k)
+        if (solver.eigenvalues()[k] > 1e-9 * largest)
+            solved[k] = along[k] / solver.eigenvalues()[k];
+    const Vector6d move = scale.asDiagonal() * (solver.eigenvectors() * solved);
+    double left = 0.0;
+    for (TileTerm& term : terms_) {
+        term.residualPx = (term.shift - term.onPanel * move).norm();
+        if (term.inlier)
+            left += term.residualPx * term.residualPx;
+    }
+    const double n = static_cast<double>(used);
+    Fit fit;
+    fit.tiles = used;
+    fit.beforePx = std::sqrt(squares / n);
+    fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
+    fit.noisePx = std::sqrt(left / (n - 3.0));
+    return fit;
+}
+
+CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vector<TileShift>& tiles) {
+    prepareTerms(tiles);
+    Fit fit = fitMove();
+    // A tile whose peak was one of chance, or that was read while the camera moved, is far off any move
+    // that fits the others: such tiles are set aside while enough remain for the camera's pose.
+    for (int pass = 0; pass < kOutlierPasses; ++pass) {
+        residuals_.clear();
+        for (const TileTerm& term : terms_)
+            if (term.inlier)
+                residuals_.push_back(term.residualPx);
+        const auto middle = residuals_.begin() + static_cast<std::ptrdiff_t>(residuals_.size() / 2);
+        std::nth_element(residuals_.begin(), middle, residuals_.end());
+        const double limit = std::max(kOutlierMedians * *middle, 0.5 * options_.leastErrorPx);
+        int kept = 0, dropped = 0;
+        for (const TileTerm& term : terms_)
+            if (term.inlier)
+                (term.residualPx > limit ? dropped : kept) += 1;
+        if (dropped == 0 || kept < kMinRelocationTiles)
+            break;
+        for (TileTerm& term : terms_)
+            term.inlier = term.inlier && term.residualPx <= limit;
+        fit = fitMove();
+    }
+    return fit;
+}
+
+double CalibrationCorrector::misregistrationPx(const Calibration& corrected,
+                                               const std::vector<TileShift>& tiles) const {
+    const Calibration& measured = *calibration_;
+    const CameraModel camera{measured.cameraMatrix, measured.cameraDistortion};
+    const Eigen::Matrix3d cameraToProjector = measured.cameraToProjectorHomography();
+    const Eigen::Matrix3d projectorToTable = measured.tableToProjectorHomography().inverse();
+    double squares = 0.0;
+    for (const TileShift& tile : tiles) {
+        const TileGeometry geometry = tileGeometry(camera, cameraToProjector, projectorToTable, tile);
+        const Eigen::Vector2d predicted = seenAt(camera, corrected.tableToCamera, geometry.tablePoint);
+        squares += (geometry.toProjector * (geometry.observed - predicted)).squaredNorm();
+    }
+    return std::sqrt(squares / static_cast<double>(tiles.size()));
+}
+
+std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t measured,
+                                                                  const std::vector<TileShift>& latest) {
+    if (measured < judged_)
+        judged_ = 0;  // the check started over
+    if (!calibration_ || measured < judged_ + static_cast<std::uint64_t>(tilesPerRound_) ||
+        static_cast<int>(latest.size()) < tilesPerRound_)
+        return std::nullopt;
+    judged_ = measured;
+    problem_.clear();
+    // A round that straddles a knock shows two misregistrations at once: a problem is told once two rounds
+    // running show it.
+    const auto off = [&](std::string_view why) -> std::optional<CalibrationCorrection> {
+        if (++roundsOff_ >= 2)
+            problem_ = why;
+        return std::nullopt;
+    };
+    const Fit fit = fitMoveRobustly(latest);
+    const double notableNoisePx = options_.noiseMultiple * fit.noisePx;
+    if (fit.beforePx < std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0))) {
+        // The calibration holds: what the tiles show is their noise.
+        heldNoisePx_ = fit.noisePx;
+        roundsOff_ = 0;
+        return std::nullopt;
+    }
+    char figures[160];
+    if (fit.explainedPx < std::max(options_.leastErrorPx, notableNoisePx)) {
+        std::snprintf(
+            figures, sizeof figures,
+            "the code lies %.2f projector px from where the calibration puts it, and no move of the "
+            "camera explains it (%.2f px of it)",
+            fit.beforePx, fit.explainedPx);
+        return off(figures);
+    }
+    inliers_.clear();
+    for (std::size_t i = 0; i < latest.size(); ++i)
+        if (terms_[i].inlier)
+            inliers_.push_back(latest[i]);
+    Result<CameraRelocation> relocation = relocateCamera(*calibration_, inliers_);
+    if (!relocation.ok())
+        return off(relocation.failure().message);
+    CalibrationCorrection correction;
+    correction.calibration = *calibration_;
+    correction.calibration.tableToCamera = relocation->tableToCamera;
+    correction.beforePx = fit.beforePx;
+    correction.afterPx = misregistrationPx(correction.calibration, inliers_);
+    correction.what = "camera";
+    correction.tiles = static_cast<int>(inliers_.size());
+    const double noisePx = heldNoisePx_.value_or(fit.noisePx);
+    if (correction.afterPx > options_.noiseMultiple * noisePx) {
+        std::snprintf(figures, sizeof figures,
+                      "the code lies %.2f projector px from where the calibration puts it, and the camera's "
+                      "new pose would leave %.2f px, more than the %.2f px of noise seen",
+                      correction.beforePx, correction.afterPx, noisePx);
+        return off(figures);
+    }
+    calibration_ = correction.calibration;
+    roundsOff_ = 0;
+    judged_ = 0;  // the check measures against the corrected calibration from its first tile on
+    return correction;
+}
+
+}  // namespace everytouch::core

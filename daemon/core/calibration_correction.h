@@ -1,0 +1,101 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/calibration.h"
+#include "core/registration_check.h"
+
+namespace everytouch::core {
+
+struct CorrectionOptions {
+    // A move is corrected when it explains a misregistration (RMS over the tiles, projector pixels) of at
+    // least this many times the tiles' own noise, the scatter the move leaves unexplained: a move of noise
+    // alone explains about 0.6 times the noise over 16 tiles (6 parameters of 32 coordinates).
+    double noiseMultiple = 3.0;
+    // ... and of at least this much, projector pixels: on the default rig 1 mm of height moves the code by
+    // 0.19 projector pixels, and a fingertip's height already scatters by about a millimetre from tap to tap,
+    // so a smaller misregistration changes no touch, and correcting it would only chase the calibration's own
+    // small errors.
+    double leastErrorPx = 0.2;
+
+    std::optional<std::string> validate() const;
+};
+
+// A calibration corrected from the code on the table.
+struct CalibrationCorrection {
+    Calibration calibration;  // the corrected one
+    double beforePx = 0.0;    // the misregistration over the tiles it rests on, RMS, projector pixels
+    double afterPx = 0.0;     // what the corrected calibration leaves of it, RMS, projector pixels
+    std::string what;         // what moved: "camera"
+    int tiles = 0;
+};
+
+// Keeps the calibration true when the camera is knocked or its mount sags. After every round of tiles the
+// registration check measures (core/registration_check.h), it fits a small move of the camera against the
+// table to their shifts, by least squares on the shifts each of the camera pose's six parameters would cause
+// (in projector pixels, the scale the code is read in). What the move leaves unexplained is the tiles' noise.
+// When the move explains a misregistration that is large against that noise and against leastErrorPx, the
+// camera's pose is estimated anew from the tiles (core/camera_relocation.h) and kept when it leaves no more
+// than noiseMultiple times the noise seen while the calibration held (or, before any such round, the noise of
+// this one). The calibration holds while the misregistration stays below leastErrorPx and below
+// noiseMultiple times that noise. A misregistration that is large but that no move of the camera explains
+// (the table tilted, the projector's image crept) is not corrected; problem() says why once two rounds
+// running found it. Tiles far off the move that fits the others (a peak of chance, a tile read while the
+// camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
+class CalibrationCorrector {
+public:
+    // Throws std::invalid_argument when options.validate() fails.
+    explicit CalibrationCorrector(const CorrectionOptions& options = {});
+
+    // The calibration the tiles are measured against; tilesPerRound: how many new tiles make a round (the
+    // check's tilesPerEstimate). Forgets the noise seen so far.
+    void setRig(const Calibration& calibration, int tilesPerRound);
+
+    // `measured`: how many tiles the check has measured since its rig was set; `latest`: its latest tiles.
+    // Once a round of new tiles is in, judges them: a correction when one is warranted and confident.
+    std::optional<CalibrationCorrection> update(std::uint64_t measured, const std::vector<TileShift>& latest);
+
+    // Why the last round's misregistration, although large, was not corrected; empty when it was or when
+    // there was nothing to correct.
+    const std::string& problem() const { return problem_; }
+
+private:
+    struct Fit {
+        int tiles = 0;             // the tiles fitted
+        double beforePx = 0.0;     // RMS shift over the tiles, projector pixels
+        double explainedPx = 0.0;  // RMS of the part a move of the camera explains
+        double noisePx = 0.0;      // RMS per tile of the rest, corrected for the parameters fitted
+    };
+    // One tile's equations in projector pixels: the shift each parameter of the camera's pose would cause,
+    // and the shift measured.
+    struct TileTerm {
+        Eigen::Matrix<double, 2, 6> onPanel;
+        Eigen::Vector2d shift;
+        bool inlier = true;
+        double residualPx = 0.0;  // what the last fit left of the shift
+    };
+    void prepareTerms(const std::vector<TileShift>& tiles);
+    Fit fitMove();  // over the inlier terms
+    Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
+    // RMS distance, projector pixels, between each tile's observed place and where `calibration` puts it.
+    double misregistrationPx(const Calibration& calibration, const std::vector<TileShift>& tiles) const;
+
+    CorrectionOptions options_;
+    std::optional<Calibration> calibration_;
+    int tilesPerRound_ = 16;
+    std::uint64_t judged_ = 0;           // the check's tile count at the last round
+    std::optional<double> heldNoisePx_;  // the tiles' noise in the last round that found nothing to correct
+    int roundsOff_ = 0;                  // rounds running that found a misregistration and did not correct it
+    std::string problem_;
+    // Scratch, reserved for a round by setRig.
+    std::vector<TileTerm> terms_;
+    std::vector<double> residuals_;
+    std::vector<TileShift> inliers_;
+};
+
+}  // namespace everytouch::core
