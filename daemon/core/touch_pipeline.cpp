@@ -136,10 +136,13 @@ void TouchPipeline::adoptCorrection(const CalibrationCorrection& correction,
     segmenter_.setRig(calibration, settings.pattern, codeBlurPx_);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
     height_.setRig(calibration, settings.pattern);
-    if (!codeBlurMeasured_)
-        codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
     registration_.setRig(calibration, settings.pattern, segmenter_.judgedRegion(),
                          codeBlurPx_.value_or(options_.segmentation.cameraBlurPx));
+    // A blur measured while the code lay off its prediction (a camera knocked before detection started)
+    // is the misregistration's as much as the rig's: it is measured again against the corrected prediction.
+    codeBlur_.setRig(calibration, settings.pattern, segmenter_.judgedRegion());
+    codeBlurMeasured_ = false;
+    pairsUntilBlurMeasure_ = 0;
     prepareFingertips(calibration);
     rigCalibration_ = calibration;
     // The fingertips' evidence was gathered through the old geometry; the tracks and contacts go on.

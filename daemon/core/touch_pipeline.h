@@ -135,7 +135,7 @@ private:
 
     void adoptRig(const PipelineSettings& settings);
     // Goes on with `correction`'s calibration from the next pair: every stage that predicts the code is
-    // prepared for it, while the tracks, their contacts and the code's blur stay.
+    // prepared for it and the code's blur measured again, while the tracks and their contacts stay.
     void adoptCorrection(const CalibrationCorrection& correction, const PipelineSettings& settings);
     void prepareFingertips(const Calibration& calibration);
     void measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings);
