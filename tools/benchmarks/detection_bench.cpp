@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/calibration_correction.h"
 #include "core/code_blur.h"
 #include "core/code_evidence.h"
 #include "core/code_image.h"
@@ -249,6 +250,35 @@ void BM_RegistrationCheck(benchmark::State& state) {
     state.counters["error_px"] = registration.errorPx().value_or(-1.0);
 }
 BENCHMARK(BM_RegistrationCheck)->Unit(benchmark::kMicrosecond);
+
+// One round of the calibration's correction over 16 tiles of a calibration that holds: the move fitted,
+// nothing to correct (the pipeline runs it once every 16 pairs).
+void BM_CalibrationCorrectorRound(benchmark::State& state) {
+    cv::setNumThreads(1);
+    const Scene& scene = oneHand();
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    core::RegistrationCheck registration;
+    registration.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion(), 0.5);
+    cv::Mat subtraction, texture, mask;
+    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
+    segmenter.segment(texture, subtraction, mask);
+    std::int64_t timestampUs = 0;
+    while (static_cast<int>(registration.latest().size()) < core::RegistrationOptions{}.tilesPerEstimate)
+        registration.update(subtraction, mask, ++timestampUs);
+    core::CalibrationCorrector corrector;
+    corrector.setRig(scene.calibration, core::RegistrationOptions{}.tilesPerEstimate);
+    Timings timings;
+    std::uint64_t measured = 0;
+    for (auto _ : state) {
+        measured += static_cast<std::uint64_t>(core::RegistrationOptions{}.tilesPerEstimate);
+        const auto start = Clock::now();
+        benchmark::DoNotOptimize(corrector.update(measured, registration.latest()));
+        timings.add(Clock::now() - start);
+    }
+    timings.report(state);
+}
+BENCHMARK(BM_CalibrationCorrectorRound)->Unit(benchmark::kMicrosecond);
 
 void runPipeline(benchmark::State& state, const Scene& scene) {
     cv::setNumThreads(1);
