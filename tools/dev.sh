@@ -106,6 +106,8 @@ sanitize)
         'TouchPipelineRendered\.ADragStaysOneTouch'
         'TouchPipelineRendered\.OnlyAStillSceneKeepsItsMask'
         'TouchPipelineRendered\.AFingerRestingOnTheTableIsNotLostToOnePairsSegmentation'
+        # The knock left uncorrected: the same frames and code as the corrected knock's case.
+        'TouchPipelineRendered\.WithoutTheCorrectionAKnockedCameraStaysMisregistered'
         'HandSegmentation\.ACameraFramedOnTheProjectionStillTellsTheTableFromTheHand'
         # The code's blur and the renderer's hand mask measured over many rendered frames (13-17 s each):
         # CodeBlur's and SimSource's other cases run the same code.
