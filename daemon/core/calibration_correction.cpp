@@ -228,7 +228,7 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
         roundsOff_ = 0;
         return std::nullopt;
     }
-    char figures[160];
+    char figures[256];
     if (fit.explainedPx < std::max(options_.leastErrorPx, notableNoisePx)) {
         std::snprintf(
             figures, sizeof figures,
@@ -252,7 +252,8 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     correction.what = "camera";
     correction.tiles = static_cast<int>(inliers_.size());
     const double noisePx = heldNoisePx_.value_or(fit.noisePx);
-    if (correction.afterPx > options_.noiseMultiple * noisePx) {
+    // What would count as holding is good enough, even beside a very quiet camera's noise.
+    if (correction.afterPx > std::max(options_.leastErrorPx, options_.noiseMultiple * noisePx)) {
         std::snprintf(figures, sizeof figures,
                       "the code lies %.2f projector px from where the calibration puts it, and the camera's "
                       "new pose would leave %.2f px, more than the %.2f px of noise seen",

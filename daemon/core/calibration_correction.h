@@ -40,13 +40,13 @@ struct CalibrationCorrection {
 // table to their shifts, by least squares on the shifts each of the camera pose's six parameters would cause
 // (in projector pixels, the scale the code is read in). What the move leaves unexplained is the tiles' noise.
 // When the move explains a misregistration that is large against that noise and against leastErrorPx, the
-// camera's pose is estimated anew from the tiles (core/camera_relocation.h) and kept when it leaves no more
-// than noiseMultiple times the noise seen while the calibration held (or, before any such round, the noise of
-// this one). The calibration holds while the misregistration stays below leastErrorPx and below
-// noiseMultiple times that noise. A misregistration that is large but that no move of the camera explains
-// (the table tilted, the projector's image crept) is not corrected; problem() says why once two rounds
-// running found it. Tiles far off the move that fits the others (a peak of chance, a tile read while the
-// camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
+// camera's pose is estimated anew from the tiles (core/camera_relocation.h) and kept when it leaves less than
+// leastErrorPx or no more than noiseMultiple times the noise seen while the calibration held (or, before any
+// such round, the noise of this one). The calibration holds while the misregistration stays below
+// leastErrorPx and below noiseMultiple times that noise. A misregistration that is large but that no move of
+// the camera explains (the table tilted, the projector's image crept) is not corrected; problem() says why
+// once two rounds running found it. Tiles far off the move that fits the others (a peak of chance, a tile
+// read while the camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
 class CalibrationCorrector {
 public:
     // Throws std::invalid_argument when options.validate() fails.
