@@ -47,30 +47,6 @@ Eigen::Vector2d seenAt(const CameraModel& camera, const Eigen::Isometry3d& pose,
     return camera.project(pose * point);
 }
 
-// What the check measured at one tile, in the terms of a camera pose: the table point the projector lights
-// through the code predicted at the tile's centre, where the camera now sees it, and how camera pixels there
-// map to projector pixels.
-struct TileGeometry {
-    Eigen::Vector3d tablePoint;
-    Eigen::Vector2d observed;
-    Eigen::Matrix2d toProjector;
-};
-
-TileGeometry tileGeometry(const CameraModel& camera, const Eigen::Matrix3d& cameraToProjector,
-                          const Eigen::Matrix3d& projectorToTable, const TileShift& tile) {
-    const auto lit = [&](const Eigen::Vector2d& raw) {
-        return applyHomography(cameraToProjector, camera.undistortPixel(raw));
-    };
-    TileGeometry geometry;
-    const Eigen::Vector2d onTable = applyHomography(projectorToTable, lit(tile.centre));
-    geometry.tablePoint = Eigen::Vector3d(onTable.x(), onTable.y(), 0.0);
-    geometry.observed = tile.centre + tile.cameraPx;
-    const Eigen::Vector2d dx = Eigen::Vector2d(kPixelStep, 0.0), dy = Eigen::Vector2d(0.0, kPixelStep);
-    geometry.toProjector.col(0) = (lit(tile.centre + dx) - lit(tile.centre - dx)) / (2.0 * kPixelStep);
-    geometry.toProjector.col(1) = (lit(tile.centre + dy) - lit(tile.centre - dy)) / (2.0 * kPixelStep);
-    return geometry;
-}
-
 }  // namespace
 
 std::optional<std::string> CorrectionOptions::validate() const {
@@ -101,6 +77,22 @@ void CalibrationCorrector::setRig(const Calibration& calibration, int tilesPerRo
     problem_.clear();
 }
 
+CalibrationCorrector::TileGeometry CalibrationCorrector::tileGeometry(
+    const CameraModel& camera, const Eigen::Matrix3d& cameraToProjector,
+    const Eigen::Matrix3d& projectorToTable, const TileShift& tile) {
+    const auto lit = [&](const Eigen::Vector2d& raw) {
+        return applyHomography(cameraToProjector, camera.undistortPixel(raw));
+    };
+    TileGeometry geometry;
+    const Eigen::Vector2d onTable = applyHomography(projectorToTable, lit(tile.centre));
+    geometry.tablePoint = Eigen::Vector3d(onTable.x(), onTable.y(), 0.0);
+    geometry.observed = tile.centre + tile.cameraPx;
+    const Eigen::Vector2d dx = Eigen::Vector2d(kPixelStep, 0.0), dy = Eigen::Vector2d(0.0, kPixelStep);
+    geometry.toProjector.col(0) = (lit(tile.centre + dx) - lit(tile.centre - dx)) / (2.0 * kPixelStep);
+    geometry.toProjector.col(1) = (lit(tile.centre + dy) - lit(tile.centre - dy)) / (2.0 * kPixelStep);
+    return geometry;
+}
+
 void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
     const Calibration& calibration = *calibration_;
     const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
@@ -118,7 +110,7 @@ void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
             derivative.col(k) =
                 (seenAt(camera, movedPose(pose, move), geometry.tablePoint) - predicted) / move[k];
         }
-        terms_.push_back({geometry.toProjector * derivative,
+        terms_.push_back({geometry, geometry.toProjector * derivative,
                           geometry.toProjector * (geometry.observed - predicted), true, 0.0});
     }
 }
@@ -156,7 +148,6 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMove() {
     }
     const double n = static_cast<double>(used);
     Fit fit;
-    fit.tiles = used;
     fit.beforePx = std::sqrt(squares / n);
     fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
     fit.noisePx = std::sqrt(left / (n - 3.0));
@@ -189,19 +180,18 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vecto
     return fit;
 }
 
-double CalibrationCorrector::misregistrationPx(const Calibration& corrected,
-                                               const std::vector<TileShift>& tiles) const {
-    const Calibration& measured = *calibration_;
-    const CameraModel camera{measured.cameraMatrix, measured.cameraDistortion};
-    const Eigen::Matrix3d cameraToProjector = measured.cameraToProjectorHomography();
-    const Eigen::Matrix3d projectorToTable = measured.tableToProjectorHomography().inverse();
+double CalibrationCorrector::inlierMisregistrationPx(const Calibration& corrected) const {
+    const CameraModel camera{corrected.cameraMatrix, corrected.cameraDistortion};
     double squares = 0.0;
-    for (const TileShift& tile : tiles) {
-        const TileGeometry geometry = tileGeometry(camera, cameraToProjector, projectorToTable, tile);
-        const Eigen::Vector2d predicted = seenAt(camera, corrected.tableToCamera, geometry.tablePoint);
-        squares += (geometry.toProjector * (geometry.observed - predicted)).squaredNorm();
+    int used = 0;
+    for (const TileTerm& term : terms_) {
+        if (!term.inlier)
+            continue;
+        const Eigen::Vector2d predicted = seenAt(camera, corrected.tableToCamera, term.geometry.tablePoint);
+        squares += (term.geometry.toProjector * (term.geometry.observed - predicted)).squaredNorm();
+        ++used;
     }
-    return std::sqrt(squares / static_cast<double>(tiles.size()));
+    return std::sqrt(squares / static_cast<double>(used));
 }
 
 std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t measured,
@@ -248,7 +238,7 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     correction.calibration = *calibration_;
     correction.calibration.tableToCamera = relocation->tableToCamera;
     correction.beforePx = fit.beforePx;
-    correction.afterPx = misregistrationPx(correction.calibration, inliers_);
+    correction.afterPx = inlierMisregistrationPx(correction.calibration);
     correction.what = "camera";
     correction.tiles = static_cast<int>(inliers_.size());
     const double noisePx = heldNoisePx_.value_or(fit.noisePx);

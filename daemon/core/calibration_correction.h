@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "core/calibration.h"
+#include "core/camera_model.h"
 #include "core/registration_check.h"
 
 namespace everytouch::core {
@@ -66,14 +67,24 @@ public:
 
 private:
     struct Fit {
-        int tiles = 0;             // the tiles fitted
         double beforePx = 0.0;     // RMS shift over the tiles, projector pixels
         double explainedPx = 0.0;  // RMS of the part a move of the camera explains
         double noisePx = 0.0;      // RMS per tile of the rest, corrected for the parameters fitted
     };
+    // What the check measured at one tile, in the terms of a camera pose: the table point the projector
+    // lights through the code predicted at the tile's centre, where the camera now sees it, and how camera
+    // pixels there map to projector pixels.
+    struct TileGeometry {
+        Eigen::Vector3d tablePoint;
+        Eigen::Vector2d observed;
+        Eigen::Matrix2d toProjector;
+    };
+    static TileGeometry tileGeometry(const CameraModel& camera, const Eigen::Matrix3d& cameraToProjector,
+                                     const Eigen::Matrix3d& projectorToTable, const TileShift& tile);
     // One tile's equations in projector pixels: the shift each parameter of the camera's pose would cause,
     // and the shift measured.
     struct TileTerm {
+        TileGeometry geometry;
         Eigen::Matrix<double, 2, 6> onPanel;
         Eigen::Vector2d shift;
         bool inlier = true;
@@ -82,8 +93,9 @@ private:
     void prepareTerms(const std::vector<TileShift>& tiles);
     Fit fitMove();  // over the inlier terms
     Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
-    // RMS distance, projector pixels, between each tile's observed place and where `calibration` puts it.
-    double misregistrationPx(const Calibration& calibration, const std::vector<TileShift>& tiles) const;
+    // RMS distance, projector pixels, between each inlier tile's observed place and where `corrected` puts
+    // its table point.
+    double inlierMisregistrationPx(const Calibration& corrected) const;
 
     CorrectionOptions options_;
     std::optional<Calibration> calibration_;

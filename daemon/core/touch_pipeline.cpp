@@ -169,6 +169,7 @@ void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSe
 const PipelineResult& TouchPipeline::process(const FramePair& pair, const PipelineSettings& settings) {
     result_.frameIndex = pair.latest().index;
     result_.sceneStill = false;
+    result_.correction.reset();  // told in the one pair that made it, idle pairs included
     result_.timestampUs = pair.latest().timestampUs;
     result_.handMask.create(pair.positive.image.size(), CV_8UC1);
     const auto idle = [&](std::string_view reason) -> const PipelineResult& {
@@ -234,7 +235,6 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     }
     registration_.update(result_.subtraction, result_.handMask, result_.timestampUs);
     result_.calibrationErrorPx = registration_.errorPx();
-    result_.correction.reset();
     if (options_.correctCalibration) {
         if (std::optional<CalibrationCorrection> correction =
                 corrector_.update(registration_.measured(), registration_.latest()))

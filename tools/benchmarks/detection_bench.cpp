@@ -226,18 +226,32 @@ void BM_CodeBlur(benchmark::State& state) {
 }
 BENCHMARK(BM_CodeBlur)->Unit(benchmark::kMillisecond);
 
+// The one-hand scene's first pair as the calibration's check sees it: S, the hand's mask, the check set up.
+struct CheckedPair {
+    core::RegistrationCheck registration;
+    cv::Mat subtraction, mask;
+};
+
+CheckedPair checkedPair(const Scene& scene) {
+    core::HandSegmenter segmenter{core::SegmentationOptions{}};
+    segmenter.setRig(scene.calibration, scene.pattern);
+    CheckedPair checked;
+    checked.registration.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion(), 0.5);
+    cv::Mat texture;
+    core::computeSubtractionAndTexture(scene.pairs.front(), checked.subtraction, texture);
+    segmenter.segment(texture, checked.subtraction, checked.mask);
+    return checked;
+}
+
 // The calibration's check: one tile of the table per pair (the hand's tiles passed over), as the pipeline
 // runs it.
 void BM_RegistrationCheck(benchmark::State& state) {
     cv::setNumThreads(1);
     const Scene& scene = oneHand();
-    core::HandSegmenter segmenter{core::SegmentationOptions{}};
-    segmenter.setRig(scene.calibration, scene.pattern);
-    core::RegistrationCheck registration;
-    registration.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion(), 0.5);
-    cv::Mat subtraction, texture, mask;
-    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
-    segmenter.segment(texture, subtraction, mask);
+    CheckedPair checked = checkedPair(scene);
+    core::RegistrationCheck& registration = checked.registration;
+    const cv::Mat& subtraction = checked.subtraction;
+    const cv::Mat& mask = checked.mask;
     Timings timings;
     std::int64_t timestampUs = 0;
     for (auto _ : state) {
@@ -256,13 +270,10 @@ BENCHMARK(BM_RegistrationCheck)->Unit(benchmark::kMicrosecond);
 void BM_CalibrationCorrectorRound(benchmark::State& state) {
     cv::setNumThreads(1);
     const Scene& scene = oneHand();
-    core::HandSegmenter segmenter{core::SegmentationOptions{}};
-    segmenter.setRig(scene.calibration, scene.pattern);
-    core::RegistrationCheck registration;
-    registration.setRig(scene.calibration, scene.pattern, segmenter.judgedRegion(), 0.5);
-    cv::Mat subtraction, texture, mask;
-    core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
-    segmenter.segment(texture, subtraction, mask);
+    CheckedPair checked = checkedPair(scene);
+    core::RegistrationCheck& registration = checked.registration;
+    const cv::Mat& subtraction = checked.subtraction;
+    const cv::Mat& mask = checked.mask;
     std::int64_t timestampUs = 0;
     while (static_cast<int>(registration.latest().size()) < core::RegistrationOptions{}.tilesPerEstimate)
         registration.update(subtraction, mask, ++timestampUs);
