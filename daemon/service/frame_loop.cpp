@@ -275,9 +275,12 @@ void FrameLoop::recordPipelineTime(double ms) {
 void FrameLoop::processPair(const core::FramePair& pair, const core::PipelineSettings& settings) {
     const Clock::time_point start = Clock::now();
     const core::PipelineResult* result = nullptr;
+    processing_ = true;
     try {
         result = &pipeline_.process(pair, settings);
+        processing_ = false;
     } catch (const std::exception& error) {
+        processing_ = false;
         // Every contact goes at once; the failure is told once, not for every pair while it lasts.
         pipeline_.reset();
         if (detecting_.exchange(false))

@@ -103,6 +103,8 @@ public:
     core::Contacts contacts(std::uint64_t& version) const;
     // The last time the pipeline thread showed it is alive (it wakes at least every 100 ms).
     std::chrono::steady_clock::time_point heartbeat() const;
+    // Whether the pipeline is working on a pair now (a new calibration's preparation may take a while).
+    bool processing() const { return processing_; }
 
     void setSettings(core::PipelineSettings settings);
     // The pipeline's latest correction of the calibration (core/calibration_correction.h) not taken yet.
@@ -160,6 +162,7 @@ private:
     std::uint64_t polaritySwaps_ = 0;     // as the pipeline last reported them (pipeline thread)
     std::string calibrationProblemSeen_;  // as the pipeline last reported it (pipeline thread)
     std::atomic<std::int64_t> heartbeatNs_{0};
+    std::atomic<bool> processing_{false};
     std::thread camera_;
     std::thread pipelineThread_;
 

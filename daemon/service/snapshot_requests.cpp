@@ -39,6 +39,7 @@ void SnapshotRequests::add(SnapshotKind kind, int fd, SnapshotReply reply) {
     request.id = id;
     request.reply = std::move(reply);
     request.kind = kind;
+    request.asked = std::chrono::steady_clock::now();
     sd_event_source* timeout = nullptr;
     const auto timeoutUsec = std::chrono::duration_cast<std::chrono::microseconds>(timeouts_.frame).count();
     if (const int r =
@@ -103,7 +104,7 @@ void SnapshotRequests::fail(std::uint64_t id, const char* errorName, const std::
     reply.failed(errorName, message);
 }
 
-int SnapshotRequests::onTimeout(sd_event_source*, uint64_t, void* userdata) noexcept {
+int SnapshotRequests::onTimeout(sd_event_source* source, uint64_t, void* userdata) noexcept {
     auto* request = static_cast<Request*>(userdata);
     try {
         const SnapshotTimeouts& timeouts = request->owner->timeouts_;
@@ -112,10 +113,23 @@ int SnapshotRequests::onTimeout(sd_event_source*, uint64_t, void* userdata) noex
             message << "The reader did not take the PNG within "
                     << std::chrono::duration<double>(timeouts.write).count() << " s";
             request->owner->fail(request->id, SD_BUS_ERROR_IO_ERROR, message.str());
-        } else {
+        } else if (!request->owner->loop_.processing()) {
             message << "No camera frame pair arrived within "
                     << std::chrono::duration<double>(timeouts.frame).count() << " s";
             request->owner->fail(request->id, bus::kErrorNoCamera, message.str());
+        } else if (std::chrono::steady_clock::now() - request->asked < timeouts.frame + timeouts.busy) {
+            const auto waitUsec =
+                std::chrono::duration_cast<std::chrono::microseconds>(timeouts.frame).count();
+            int r = sd_event_source_set_time_relative(source, static_cast<std::uint64_t>(waitUsec));
+            if (r >= 0)
+                r = sd_event_source_set_enabled(source, SD_EVENT_ONESHOT);
+            if (r < 0)
+                request->owner->fail(request->id, SD_BUS_ERROR_FAILED,
+                                     std::string("Cannot set a timeout: ") + std::strerror(-r));
+        } else {
+            message << "Detection has been working on one frame pair for more than "
+                    << std::chrono::duration<double>(timeouts.busy).count() << " s";
+            request->owner->fail(request->id, bus::kErrorBusy, message.str());
         }
     } catch (const std::exception& error) {
         ET_LOG(Error) << "internal error: " << error.what();

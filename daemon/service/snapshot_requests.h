@@ -35,6 +35,10 @@ struct SnapshotTimeouts {
     // How long the receiving end of a descriptor may take to accept the PNG; it is written while the main
     // loop goes on, and a client that never reads gets an error after this time.
     std::chrono::milliseconds write{3000};
+    // A request whose pair has not come within `frame` waits on while detection works on a pair (the first
+    // pair of a new calibration prepares it: a few tenths of a second, seconds on a slow machine), up to this
+    // much longer.
+    std::chrono::milliseconds busy{30000};
 };
 
 // The Snapshot calls waiting for a frame pair: each keeps its own descriptor for the caller's and a timeout,
@@ -69,6 +73,7 @@ private:
         SnapshotReply reply;
         DescriptorWriter writer;
         bool writing = false;  // the pair came; the timeout is now the write's
+        std::chrono::steady_clock::time_point asked;
         SnapshotKind kind = SnapshotKind::Camera;
         FrameTap::Ticket ticket = 0;
         io::EventSource timeout;

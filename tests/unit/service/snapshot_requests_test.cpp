@@ -156,6 +156,60 @@ TEST_F(SnapshotRequestsTest, WithoutFramesTheRequestFailsAfterItsTimeoutAndStays
     EXPECT_EQ(std::filesystem::file_size(dir_ / "snapshot.png"), 0u);
 }
 
+// A pipeline whose first pair takes as long as a new calibration's preparation on a slow machine.
+class SlowFirstPairPipeline final : public core::PairPipeline {
+public:
+    explicit SlowFirstPairPipeline(Clock::duration firstPair) : firstPair_(firstPair) {}
+    const core::PipelineResult& process(const core::FramePair& pair, const core::PipelineSettings&) override {
+        if (pairs_++ == 0)
+            std::this_thread::sleep_for(firstPair_);
+        result_.frameIndex = pair.latest().index;
+        return result_;
+    }
+    void reset() override {}
+
+private:
+    Clock::duration firstPair_;
+    int pairs_ = 0;
+    core::PipelineResult result_;
+};
+
+TEST_F(SnapshotRequestsTest, WaitsForAPairDetectionIsStillWorkingOnAndNoLonger) {
+    io::ReplaySource source(dir_ / "recording", false);
+    SlowFirstPairPipeline slow(400ms);
+    FrameLoop loop(source, slow, {}, nullptr, options_, {}, [] {});
+    MarkingRenderer renderer;
+    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function(),
+                              SnapshotTimeouts{100ms, 3000ms, 1000ms});
+    loop.start();
+    ASSERT_TRUE(runUntil([&] { return loop.processing(); }, 10s));
+    Answers answers;
+    io::UniqueFd fd = openForWriting("snapshot.png");
+    requests.add(SnapshotKind::Camera, fd.get(), answers.reply());
+    ASSERT_TRUE(runUntil([&] { return answers.done + answers.failures.size() > 0; }, 10s));
+    EXPECT_EQ(answers.done, 1) << (answers.failures.empty() ? "" : answers.failures.front().second);
+    ASSERT_TRUE(runUntil([&] { return loop.finished(); }, 30s));
+
+    // A pair that takes longer than the frame's timeout and the wait beyond it together is not waited for.
+    io::ReplaySource again(dir_ / "recording", false);
+    SlowFirstPairPipeline slower(2s);
+    FrameLoop stuck(again, slower, {}, nullptr, options_, {}, [] {});
+    SnapshotRequests patient(event_.get(), stuck, inbox_, renderer.function(),
+                             SnapshotTimeouts{100ms, 3000ms, 300ms});
+    stuck.start();
+    ASSERT_TRUE(runUntil([&] { return stuck.processing(); }, 10s));
+    Answers late;
+    io::UniqueFd second = openForWriting("late.png");
+    const auto begun = Clock::now();
+    patient.add(SnapshotKind::Camera, second.get(), late.reply());
+    ASSERT_TRUE(runUntil([&] { return late.done + late.failures.size() > 0; }, 10s));
+    EXPECT_GE(Clock::now() - begun, 400ms);
+    ASSERT_EQ(late.failures.size(), 1u);
+    EXPECT_EQ(late.failures.front().first, bus::kErrorBusy);
+    EXPECT_EQ(late.failures.front().second,
+              "Detection has been working on one frame pair for more than 0.3 s");
+}
+
 TEST_F(SnapshotRequestsTest, RefusesADescriptorNotOpenForWriting) {
     io::ReplaySource source(dir_ / "recording", false);
     FrameLoop loop(source, pipeline_, {}, nullptr, options_, {}, [] {});
