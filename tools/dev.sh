@@ -106,8 +106,14 @@ sanitize)
         'TouchPipelineRendered\.ADragStaysOneTouch'
         'TouchPipelineRendered\.OnlyAStillSceneKeepsItsMask'
         'TouchPipelineRendered\.AFingerRestingOnTheTableIsNotLostToOnePairsSegmentation'
-        # The knock left uncorrected: the same frames and code as the corrected knock's case.
+        # The calibration's check and correction: the knock left uncorrected (the same frames and code as the
+        # corrected knock's case), the pipeline's correction (the daemon's knocked camera runs it, through the
+        # daemon), and the readings of a calibration that holds, measured in the normal build (7-15 s each).
         'TouchPipelineRendered\.WithoutTheCorrectionAKnockedCameraStaysMisregistered'
+        'TouchPipelineRendered\.AKnockedCameraIsSeenWithinHalfASecondAndCorrected'
+        'RegistrationCheck\.ACalibrationThatHoldsShowsAFewHundredthsOfAPixel'
+        'CalibrationCorrector\.LeavesACalibrationThatHoldsAsItIs'
+        'ServiceTest\.CalibrationErrorIsAFractionOfAPixelWhileTheCalibrationHolds'
         'HandSegmentation\.ACameraFramedOnTheProjectionStillTellsTheTableFromTheHand'
         # The code's blur and the renderer's hand mask measured over many rendered frames (13-17 s each):
         # CodeBlur's and SimSource's other cases run the same code.
