@@ -126,6 +126,12 @@ void ContactTracker::update(std::int64_t timestampUs, const std::vector<FingerOb
     for (const Track& track : tracks_) {
         if (contacts.size() == static_cast<std::size_t>(kMaxContacts))
             break;
+        // A hovering finger is placed by its height, which its code tells only while the finger holds
+        // still between a pair's two frames: one rising from a tap at 0.3 m/s shows none for ten frames.
+        // Its last height and place would be reported long after they stopped being true (0.7 mm for a
+        // finger at 30 mm); it is reported again once its height is read, under the same id.
+        if (!track.touching && track.unmeasuredFrames > options_.maxUnmeasuredFrames)
+            continue;
         const Eigen::Vector2d& position = track.filter.value();
         contacts.push_back(
             {track.id, position.x(), position.y(), track.touching, track.heightMm, track.palm});

@@ -35,7 +35,8 @@ nlohmann::json touchJson(const TouchSource& source, const TouchScore& score) {
         bands.push_back({{"from_mm", kHoverBandsMm[b][0]},
                          {"to_mm", kHoverBandsMm[b][1]},
                          {"mean", orNull(score.hoverBandErrorMm[b].value())},
-                         {"count", score.hoverBandErrorMm[b].count}});
+                         {"count", score.hoverBandErrorMm[b].count},
+                         {"finger_frames", score.hoverBandFrames[b]}});
     nlohmann::json trials = nlohmann::json::array();
     for (const TrialOutcome& outcome : score.trials) {
         nlohmann::json trial = {{"finger", outcome.trial.finger},   {"first", outcome.trial.first},
@@ -77,6 +78,7 @@ nlohmann::json touchJson(const TouchSource& source, const TouchScore& score) {
             {"latency_frames", meanJson(score.latencyFrames)},
             {"max_latency_frames", score.maxLatencyFrames},
             {"hover_error_mm", meanJson(score.hoverErrorMm)},
+            {"hover_finger_frames", score.hoverFrames},
             {"hover_error_bands", bands},
             {"id_swaps", score.idSwaps},
             {"per_trial", trials},
@@ -112,12 +114,13 @@ std::string touchTable(const TouchSource& source, const TouchScore& score) {
                           : std::string()));
     text += line("id swaps", count(score.idSwaps), "");
     text += line("hover height error, mm", fixed(score.hoverErrorMm.value(), 2),
-                 count(score.hoverErrorMm.count) + " finger frames");
+                 count(score.hoverErrorMm.count) + " of " + count(score.hoverFrames) + " finger frames");
     for (std::size_t b = 0; b < kHoverBandsMm.size(); ++b) {
         const std::string label =
             "  " + fixed(kHoverBandsMm[b][0], 0) + "-" + fixed(kHoverBandsMm[b][1], 0) + " mm";
         text += line(label.c_str(), fixed(score.hoverBandErrorMm[b].value(), 2),
-                     count(score.hoverBandErrorMm[b].count) + " finger frames");
+                     count(score.hoverBandErrorMm[b].count) + " of " + count(score.hoverBandFrames[b]) +
+                         " finger frames");
     }
     return text;
 }

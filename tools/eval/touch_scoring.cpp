@@ -116,6 +116,12 @@ TouchScore scoreTouches(const TruthFrames& truth, const DetectedFrames& detected
                 if (contact && contact->touching)
                     ++score.highHoverTouchFrames;
             }
+            if (finger.heightMm > 0.0) {
+                ++score.hoverFrames;
+                for (std::size_t b = 0; b < kHoverBandsMm.size(); ++b)
+                    if (finger.heightMm >= kHoverBandsMm[b][0] && finger.heightMm < kHoverBandsMm[b][1])
+                        ++score.hoverBandFrames[b];
+            }
             if (finger.heightMm > 0.0 && contact) {
                 const double error = std::abs(contact->heightMm - finger.heightMm);
                 score.hoverErrorMm.add(error);

@@ -82,6 +82,10 @@ struct TouchScore {
     std::int64_t maxLatencyFrames = 0;
     Mean hoverErrorMm;  // |height - truth| of hovering fingers matched to a contact
     std::array<Mean, kHoverBandsMm.size()> hoverBandErrorMm;
+    // Frame x finger hovering in each band, whether a contact was matched to it or not: the errors above
+    // cover only those a contact was reported for.
+    std::array<std::int64_t, kHoverBandsMm.size()> hoverBandFrames{};
+    std::int64_t hoverFrames = 0;
     std::int64_t idSwaps = 0;
 
     std::int64_t rejected() const;

@@ -231,11 +231,9 @@ TEST(ContactTracker, AFingertipWithoutAHeightKeepsItsTouchForAFewFramesThenLifts
         EXPECT_TRUE(feed.contacts()[0].touching) << "frame " << f;
         EXPECT_GT(millimetres(feed.contacts()[0]).x(), 60.0 + 5 * f - 5) << "it follows the finger";
     }
-    // One more and it lifts, but the finger keeps its contact and id.
-    ASSERT_EQ(feed({unmeasured({75, 40})}).size(), 1u);
-    EXPECT_EQ(feed.contacts()[0].id, id);
-    EXPECT_FALSE(feed.contacts()[0].touching);
-    // Measured on the table again: a touch again, of the same finger.
+    // One more and it lifts; neither its height nor its place known, it is not reported.
+    EXPECT_TRUE(feed({unmeasured({75, 40})}).empty());
+    // Measured on the table again: a touch again, of the same finger, which kept its id.
     feed({finger({76, 40}, 0)});
     feed({finger({77, 40}, 0)});
     EXPECT_EQ(feed.contacts()[0].id, id);
@@ -254,9 +252,32 @@ TEST(ContactTracker, AFingertipWhoseCodeFavoursTheTableStaysDownWithoutAHeight) 
         ASSERT_EQ(feed({sliding}).size(), 1u);
         EXPECT_TRUE(feed.contacts()[0].touching) << "frame " << f;
     }
-    // Without that lean, three such frames lift it.
-    for (int f = 1; f <= 3; ++f)
+    // Without that lean, three such frames lift it (and, without a height, it is no longer reported).
+    for (int f = 1; f <= 2; ++f)
         feed({unmeasured({72.0 + 2 * f, 40})});
+    ASSERT_EQ(feed.contacts().size(), 1u);
+    EXPECT_TRUE(feed.contacts()[0].touching);
+    EXPECT_TRUE(feed({unmeasured({78, 40})}).empty());
+}
+
+TEST(ContactTracker, AHoveringFingerWithoutAHeightIsReportedAgainOnlyOnceItHasOne) {
+    Feed feed;
+    feed({finger({60, 40}, 10.0)});
+    ASSERT_EQ(feed.contacts().size(), 1u);
+    const std::uint32_t id = feed.contacts()[0].id;
+    // A rising finger whose code the pair's two frames do not agree on: its last height holds for as many
+    // frames as a touch outlives without one...
+    for (int f = 1; f <= TrackerOptions{}.maxUnmeasuredFrames; ++f) {
+        ASSERT_EQ(feed({unmeasured({60, 40})}).size(), 1u) << "frame " << f;
+        EXPECT_EQ(feed.contacts()[0].heightMm, 10.0);
+    }
+    // ...and then it is not reported at that height any more, however long it stays in view.
+    for (int f = 0; f < 10; ++f)
+        EXPECT_TRUE(feed({unmeasured({60, 40})}).empty()) << "frame " << f;
+    // Its height read again, it is back, as the same finger.
+    ASSERT_EQ(feed({finger({60, 40}, 30.0)}).size(), 1u);
+    EXPECT_EQ(feed.contacts()[0].id, id);
+    EXPECT_EQ(feed.contacts()[0].heightMm, 30.0);
     EXPECT_FALSE(feed.contacts()[0].touching);
 }
 
