@@ -92,6 +92,12 @@ Eigen::Matrix3d Calibration::cameraToDisplayHomography(double heightMm) const {
     return displayToProjector.inverse() * cameraToProjectorHomography(heightMm);
 }
 
+Eigen::Matrix3d Calibration::cameraToDisplayBelowHomography(double heightMm) const {
+    // The plane z = heightMm shares the table frame's x and y: a point's coordinates on it are those of the
+    // point below it.
+    return displayToTableHomography().inverse() * tableToCameraHomography(heightMm).inverse();
+}
+
 Eigen::Matrix3d Calibration::displayToTableHomography() const {
     return tableToProjectorHomography().inverse() * displayToProjector;
 }

@@ -36,8 +36,13 @@ struct Calibration {
     Eigen::Matrix3d projectorToCameraHomography(double heightMm = 0.0) const;
     // Camera pixels -> projector pixels through the plane at heightMm: the paper's H_PC.
     Eigen::Matrix3d cameraToProjectorHomography(double heightMm = 0.0) const;
-    // Camera pixels -> display pixels through the plane at heightMm.
+    // Camera pixels -> display pixels through the plane at heightMm: the display pixel whose light falls on
+    // the point at that height the camera pixel sees.
     Eigen::Matrix3d cameraToDisplayHomography(double heightMm = 0.0) const;
+    // Camera pixels -> the display pixel straight below the point at heightMm the camera pixel sees: where a
+    // fingertip there lands when it comes straight down. Above the table the projector's ray and the
+    // vertical part by the height times the ray's slope (0.4 mm per mm on the default rig).
+    Eigen::Matrix3d cameraToDisplayBelowHomography(double heightMm) const;
     // Display pixels -> table millimetres (where the desktop's pixels land on the table).
     Eigen::Matrix3d displayToTableHomography() const;
 

@@ -291,7 +291,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         // The contact point: the pad, seen through the plane of its height.
         const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
-            applyHomography(calibration.cameraToDisplayHomography(observation.padHeightMm), undistorted);
+            applyHomography(calibration.cameraToDisplayBelowHomography(observation.padHeightMm), undistorted);
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
         finger.heightKnown = observation.visible.valid;

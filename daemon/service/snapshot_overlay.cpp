@@ -19,11 +19,12 @@ const cv::Scalar kTouchingColour(0, 0, 255);
 const cv::Scalar kHoveringColour(0, 255, 255);
 const cv::Scalar kPalmColour(160, 160, 160);
 
-// Display pixel -> raw camera pixel, through the plane `heightMm` above the table.
+// Display pixel -> raw camera pixel: the camera's view of the point `heightMm` straight above where the pixel
+// lands on the table, as a contact hovering there is.
 class DisplayToCamera {
 public:
     DisplayToCamera(const core::Calibration& calibration, double heightMm)
-        : toUndistorted_(calibration.cameraToDisplayHomography(heightMm).inverse()),
+        : toUndistorted_(calibration.cameraToDisplayBelowHomography(heightMm).inverse()),
           camera_{calibration.cameraMatrix, calibration.cameraDistortion} {}
 
     cv::Point operator()(double x, double y) const {

@@ -74,6 +74,30 @@ TEST(Calibration, CameraToDisplayComposesKeystone) {
     EXPECT_LT((display - 2.0 * projector).norm(), 1e-9);  // the display is twice the panel's resolution
 }
 
+TEST(Calibration, APointAboveTheTableMapsToTheDisplayPixelBelowItNotToTheOneLightingIt) {
+    const Calibration calibration = test::paperLikeCalibration();
+    const Eigen::Vector2d display(300, 200);
+    const Eigen::Vector2d onTable = applyHomography(calibration.displayToTableHomography(), display);
+    for (const double heightMm : {0.0, 5.0, 35.0}) {
+        // The camera's view of the point heightMm straight above where the display pixel lands.
+        const Eigen::Vector4d above(onTable.x(), onTable.y(), heightMm, 1.0);
+        const Eigen::Vector3d seen =
+            calibration.cameraMatrix * (calibration.tableToCamera.matrix() * above).head<3>();
+        const Eigen::Vector2d camera = seen.head<2>() / seen.z();
+        EXPECT_LT(
+            (applyHomography(calibration.cameraToDisplayBelowHomography(heightMm), camera) - display).norm(),
+            1e-6)
+            << heightMm << " mm";
+        // The projector's ray to that point leaves it elsewhere on the display, the more so the higher it is.
+        const double apartPx =
+            (applyHomography(calibration.cameraToDisplayHomography(heightMm), camera) - display).norm();
+        if (heightMm == 0.0)
+            EXPECT_LT(apartPx, 1e-6);
+        else
+            EXPECT_GT(apartPx, 0.1 * heightMm);
+    }
+}
+
 TEST(Calibration, DisplaySizeIsPhysicalMillimetres) {
     const cv::Size2d size = test::paperLikeCalibration().displaySizeMm();
     // About 500 mm from a 1350 px focal length projector, tilted: a 15" (381 mm) diagonal, give or take

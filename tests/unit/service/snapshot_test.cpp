@@ -102,10 +102,11 @@ TEST(Snapshot, SubtractionTakesTheLargestChannelAndClipsNegatives) {
     EXPECT_EQ(subtraction.at<std::uint8_t>(1, 1), 0);
 }
 
-// Where a display pixel appears in the raw camera image, through the plane heightMm above the table.
+// Where the camera sees the point heightMm straight above the table point a display pixel lands on.
 cv::Point cameraPixelOf(const core::Calibration& calibration, cv::Point2d display, double heightMm) {
-    const Eigen::Vector2d undistorted = core::applyHomography(
-        calibration.cameraToDisplayHomography(heightMm).inverse(), Eigen::Vector2d(display.x, display.y));
+    const Eigen::Vector2d undistorted =
+        core::applyHomography(calibration.cameraToDisplayBelowHomography(heightMm).inverse(),
+                              Eigen::Vector2d(display.x, display.y));
     const Eigen::Vector2d raw =
         core::CameraModel{calibration.cameraMatrix, calibration.cameraDistortion}.distortPixel(undistorted);
     return {cvRound(raw.x()), cvRound(raw.y())};
