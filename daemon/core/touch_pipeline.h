@@ -38,7 +38,10 @@ struct DetectionOptions {
     SegmentationOptions segmentation;
     FingertipOptions
         fingertips;  // the scale and the pad's drop come from the calibration (rigFingertipOptions)
-    HeightOptions height;
+    // Fingertips are followed while they hover up to 40 mm, and the top of a fingertip the camera reads lies
+    // up to 16 mm above its pad (a finger pointing down at the table): the heights searched reach 60 mm. The
+    // segmentation's own measure of a region's height needs only the first few millimetres.
+    HeightOptions height{.maxHeightMm = 60.0};
     TrackerOptions tracker;
     RegistrationOptions registration;
     // Whether a calibration the code shows to be off, because the camera moved, is corrected while detection

@@ -152,7 +152,7 @@ void BM_HeightOfOneFingertip(benchmark::State& state) {
     core::SegmentationOptions segmentationOptions;
     core::HandSegmenter segmenter(segmentationOptions);
     segmenter.setRig(scene.calibration, scene.pattern);
-    core::SurfaceHeight height(core::HeightOptions{});
+    core::SurfaceHeight height(core::DetectionOptions{}.height);
     height.setRig(scene.calibration, scene.pattern);
     cv::Mat subtraction, texture, mask;
     core::computeSubtractionAndTexture(scene.pairs.front(), subtraction, texture);
