@@ -173,6 +173,17 @@ const std::vector<KeySpec>& keySpecs() {
                  throw BadValue{"expected an absolute path, found \"" + value + "\""};
              config.calibrationPath = value;
          }},
+        {"Calibration", "Correct",
+         [](DaemonConfig& config, const std::string& value) {
+             if (value.empty()) {
+                 config.correctCalibration = DaemonConfig().correctCalibration;
+                 return;
+             }
+             const std::optional<bool> correct = parseBoolean(value);
+             if (!correct)
+                 throw BadValue{"expected yes or no, found \"" + value + "\""};
+             config.correctCalibration = *correct;
+         }},
         {"Projector", "Output",
          [](DaemonConfig& config, const std::string& value) {
              if (value == "overlay")

@@ -54,7 +54,8 @@ struct DaemonConfig {
     double touchHeightMm = 3.0;  // [Touch] HeightMm=: touching at or below this height, mm
     std::optional<bool> uinput;  // [Output] Uinput=: virtual touchscreen; unset: only for cameras
     std::filesystem::path calibrationPath;  // [Calibration] Path=: calibration store; empty: not configured
-    ProjectorConfig projector;              // [Projector]
+    bool correctCalibration = true;  // [Calibration] Correct=: correct it from the code while detection runs
+    ProjectorConfig projector;       // [Projector]
 
     bool operator==(const DaemonConfig&) const = default;
 };

@@ -285,7 +285,9 @@ void Daemon::startFrameLoop(std::vector<io::TouchSink*> sinks) {
     loopOptions.overflow = options_.fast ? FrameQueue::Overflow::Block : FrameQueue::Overflow::DropOldest;
     if (!options_.fast)
         loopOptions.stallAfter = kCameraStall;
-    pipeline_ = std::make_unique<core::TouchPipeline>();
+    core::DetectionOptions detection;
+    detection.correctCalibration = config_.correctCalibration;
+    pipeline_ = std::make_unique<core::TouchPipeline>(detection);
     loop_ = std::make_unique<FrameLoop>(
         *source_, *pipeline_, std::move(sinks), recorder_.get(), loopOptions, pipelineSettings(),
         [this] { inbox_.post([this] { onLoopNews(); }); },
@@ -656,6 +658,7 @@ void Daemon::reloadConfig() {
         {options_.rig.empty() && fresh.rig != config_.rig, "[Camera] Rig"},
         {fresh.uinput != config_.uinput, "[Output] Uinput"},
         {fresh.calibrationPath != config_.calibrationPath, "[Calibration] Path"},
+        {fresh.correctCalibration != config_.correctCalibration, "[Calibration] Correct"},
         {fresh.projector != config_.projector, "[Projector]"},
     };
     for (const auto& [changed, key] : restartOnly)

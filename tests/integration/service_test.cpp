@@ -353,6 +353,45 @@ TEST_F(ServiceTest, ACameraKnockedAfterTheCalibrationIsCorrectedSavedAndAnnounce
     EXPECT_THAT(daemon_->output(), HasSubstr("calibration corrected: the camera moved"));
 }
 
+TEST_F(ServiceTest, WithTheCorrectionSwitchedOffAKnockedCameraIsShownAndLeftAsItIs) {
+    io::writeCalibrationFile(dir_ / "calibration.yml", sim::rigCalibration(sim::SimParameters{}));
+    const std::string saved = test::fileContents(dir_ / "calibration.yml");
+    writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\nCorrect=no\n");
+    sd_bus* raw = nullptr;
+    ASSERT_GE(sd_bus_open_system(&raw), 0);
+    const io::Bus listener(raw);
+    int corrections = 0;
+    sd_bus_slot* slot = nullptr;
+    ASSERT_GE(sd_bus_match_signal(
+                  listener.get(), &slot, bus::kBusName, bus::kObjectPath, bus::kInterface,
+                  bus::kSignalCalibrationCorrected,
+                  [](sd_bus_message*, void* userdata, sd_bus_error*) {
+                      ++*static_cast<int*>(userdata);
+                      return 0;
+                  },
+                  &corrections),
+              0);
+    const io::BusSlot match(slot);
+    startDaemonOn("sim:grid35,knock=0.5");
+    // The check shows the knock (3 px on this rig), and goes on showing it: nothing corrects it.
+    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
+    double error = 0.0;
+    while (!(error > 2.0) && std::chrono::steady_clock::now() < deadline) {
+        error = measuredCalibrationError([&] { return get("CalibrationErrorPx"); });
+        std::this_thread::sleep_for(100ms);
+    }
+    ASSERT_GT(error, 2.0);
+    const auto watched = std::chrono::steady_clock::now() + 2s;
+    while (std::chrono::steady_clock::now() < watched)
+        if (sd_bus_process(listener.get(), nullptr) == 0)
+            sd_bus_wait(listener.get(), 100'000);
+    EXPECT_EQ(corrections, 0);
+    EXPECT_GT(measuredCalibrationError([&] { return get("CalibrationErrorPx"); }), 2.0);
+    EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), saved);
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "calibration.yml.bak"));
+    EXPECT_THAT(daemon_->output(), Not(HasSubstr("calibration corrected")));
+}
+
 TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {
     startDaemon();
     const test::ProcessResult result = test::runProcess(busctl(

@@ -43,7 +43,8 @@ TEST(Config, ReadsEveryKey) {
     test::TempDir dir;
     write(dir / "everytouchd.conf",
           "# comment\n[Camera]\nRig=replay:/srv/rec\n\n[Touch]\nHeightMm = 7.5\n[Output]\nUinput=no\n"
-          "[Calibration]\nPath=/var/lib/et/cal.yml\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
+          "[Calibration]\nPath=/var/lib/et/"
+          "cal.yml\nCorrect=no\n[Camera]\nPixelFormat=BayerGR8\nFrameRate=119.5\n"
           "ExposureUs=4000\nGainDb=6\nRegion=640x480+16+8\nTrigger=Line1\n"
           "[Projector]\nOutput=external\nSeed=18446744073709551615\nDelta=12\n");
     const DaemonConfig config = loadConfig(dir / "everytouchd.conf", true);
@@ -53,6 +54,8 @@ TEST(Config, ReadsEveryKey) {
     EXPECT_DOUBLE_EQ(config.touchHeightMm, 7.5);
     EXPECT_EQ(config.uinput, false);
     EXPECT_EQ(config.calibrationPath, "/var/lib/et/cal.yml");
+    EXPECT_FALSE(config.correctCalibration);
+    EXPECT_TRUE(DaemonConfig().correctCalibration);
     EXPECT_EQ(config.projector, (ProjectorConfig{ProjectorOutput::External,
                                                  std::numeric_limits<std::uint64_t>::max(), 12, ""}));
 
@@ -104,6 +107,8 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
         {"[Touch]\nHeightMm=nan\n", ":2: [Touch] HeightMm: expected a number"},
         {"[Output]\nUinput=maybe\n", ":2: [Output] Uinput: expected yes or no, found \"maybe\""},
         {"[Calibration]\nPath=calibration.yml\n", ":2: [Calibration] Path: expected an absolute path"},
+        {"[Calibration]\nCorrect=sometimes\n",
+         ":2: [Calibration] Correct: expected yes or no, found \"sometimes\""},
         {"[Camera]\nRig=webcam\n", ":2: [Camera] Rig: expected sim[:SCENARIO]"},
         {"[Camera]\nPixelFormat=YUV422\n",
          ":2: [Camera] PixelFormat: expected one of Mono8, RGB8, BGR8, BayerRG8, BayerBG8, BayerGR8, "
