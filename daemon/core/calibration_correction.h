@@ -44,10 +44,13 @@ struct CalibrationCorrection {
 // camera's pose is estimated anew from the tiles (core/camera_relocation.h) and kept when it leaves less than
 // leastErrorPx or no more than noiseMultiple times the noise seen while the calibration held (or, before any
 // such round, the noise of this one). The calibration holds while the misregistration stays below
-// leastErrorPx and below noiseMultiple times that noise. A misregistration that is large but that no move of
-// the camera explains (the table tilted, the projector's image crept) is not corrected; problem() says why
-// once two rounds running found it. Tiles far off the move that fits the others (a peak of chance, a tile
-// read while the camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
+// leastErrorPx and below noiseMultiple times that noise. A projector's image that creeps over the table moves
+// the code as a small move of the camera would, and is corrected as one: what the camera's pose then says is
+// where it stands against the image. A misregistration that no move of the camera explains, leaving
+// leastErrorPx or more (the table tilted), is not corrected; problem() says why once two rounds running found
+// it. One that a move explains but not yet clearly beyond the noise, leaving less than leastErrorPx, is
+// watched without a problem. Tiles far off the move that fits the others (a peak of chance, a tile read while
+// the camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
 class CalibrationCorrector {
 public:
     // Throws std::invalid_argument when options.validate() fails.

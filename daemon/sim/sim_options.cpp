@@ -177,6 +177,10 @@ const std::vector<OptionEntry>& entries() {
          number(&SimParameters::knockDeg)},
         {{"knock_mm", "how far a knock shifts the camera, in a random direction, mm (default 2)"},
          number(&SimParameters::knockMm)},
+        {{"drift_px_per_min",
+          "the projector's image creeps across the table at this rate, in a random direction, projector "
+          "pixels per minute, while the calibration stays as it was (default 0)"},
+         number(&SimParameters::driftPxPerMin)},
         {{"surface", "table surface: gray, yellow or artifacts"},
          choice(&SimParameters::surface,
                 std::vector<std::pair<std::string, SurfaceKind>>{{"gray", SurfaceKind::Gray},

@@ -43,6 +43,8 @@ std::optional<std::string> SimParameters::validate() const {
         return "knock_deg: must be a number of degrees from 0 to 10";
     if (!nonNegative(knockMm) || knockMm > 100.0)
         return "knock_mm: must be a number of millimetres from 0 to 100";
+    if (!nonNegative(driftPxPerMin) || driftPxPerMin > 60.0)
+        return "drift_px_per_min: must be a number of projector pixels per minute from 0 to 60";
     if (cameraSize.width < 16 || cameraSize.height < 16)
         return "camera_size: at least 16x16 pixels";
     if (!positive(cameraFocalMm))

@@ -45,6 +45,9 @@ struct SimParameters {
     std::optional<double> knockS;  // at this session time the camera turns by knockDeg about an axis through
     double knockDeg = 0.5;         // its centre and shifts by knockMm, axis and direction random (seeded)
     double knockMm = 2.0;
+    // The projector's image creeps across the table at this rate, projector pixels per minute, in a random
+    // (seeded) direction, as a warming projector's does; the calibration stays as it was. 0: it holds.
+    double driftPxPerMin = 0.0;
 
     // --- geometry ---
     cv::Size cameraSize{648, 488};                         // sensor, pixels

@@ -16,6 +16,10 @@ namespace everytouch::sim {
 
 namespace {
 
+// The steps the projector's image creeps in: a tenth of what 1 mm of height moves the code by on the default
+// rig (0.19 px).
+constexpr double kDriftStepPx = 0.02;
+
 std::uint64_t mix(std::uint64_t value) {
     value += 0x9E3779B97F4A7C15ull;
     value = (value ^ (value >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -156,22 +160,42 @@ Eigen::Isometry3d Simulator::knockedTableToCamera() const {
     return after;
 }
 
+Eigen::Vector2d Simulator::driftDirection() const {
+    std::mt19937_64 random(mix(parameters_.seed ^ 0x6472696674ull));
+    const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
+    return {std::cos(angle), std::sin(angle)};
+}
+
+Simulator::Placement Simulator::placementAt(double seconds) const {
+    Placement placement;
+    placement.knocked = parameters_.knockS && seconds >= *parameters_.knockS;
+    // The image creeps in steps far below what the code or a touch can tell, so that the renderer is set up
+    // again every few seconds rather than for every frame, and any frame renders alone as in the stream.
+    placement.driftSteps = static_cast<long>(
+        std::floor(parameters_.driftPxPerMin * std::max(0.0, seconds) / 60.0 / kDriftStepPx));
+    return placement;
+}
+
 core::Calibration Simulator::geometryAt(double seconds) const {
+    const Placement placement = placementAt(seconds);
     core::Calibration geometry = calibration_;
-    if (parameters_.knockS && seconds >= *parameters_.knockS)
+    if (placement.knocked)
         geometry.tableToCamera = knockedTableToCamera();
+    // The panel's image moves over the table as its principal point does.
+    const Eigen::Vector2d drift = placement.driftSteps * kDriftStepPx * driftDirection();
+    geometry.projectorMatrix(0, 2) += drift.x();
+    geometry.projectorMatrix(1, 2) += drift.y();
     return geometry;
 }
 
-void Simulator::placeCamera(bool knocked) {
-    renderer_ = std::make_unique<Renderer>(
-        parameters_, knocked ? geometryAt(*parameters_.knockS) : calibration_, pattern_);
+void Simulator::placeRig(double seconds) {
+    renderer_ = std::make_unique<Renderer>(parameters_, geometryAt(seconds), pattern_);
     if (!projectorImage_.empty())
         renderer_->setProjectorImage(projectorImage_);
     shown_.reset();
     if (!fixedImage_.empty())
         showFixedImage();
-    knocked_ = knocked;
+    placed_ = placementAt(seconds);
 }
 
 double Simulator::travelMm(const SceneState& from, const SceneState& to) {
@@ -193,8 +217,8 @@ double Simulator::travelMm(const SceneState& from, const SceneState& to) {
 void Simulator::render(std::uint64_t index, core::Frame& frame, FrameTruth& truth) {
     const double start = frameSeconds(index);
     const double exposure = exposureMs_ / 1000.0;
-    if (const bool knocked = parameters_.knockS && start >= *parameters_.knockS; knocked != knocked_)
-        placeCamera(knocked);
+    if (placementAt(start) != placed_)
+        placeRig(start);
     // The scene at mid-exposure; hands that move are also rendered at more instants of the exposure, about
     // one per camera pixel they travel, and the image averages them.
     const SceneState middle = sceneAt(start + exposure / 2.0);

@@ -36,7 +36,7 @@ public:
     // does (the camera's image and the truth follow the camera where it is).
     const core::Calibration& calibration() const { return calibration_; }
     // The rig's true geometry at `seconds` into the session: calibration() before a knock, the camera where
-    // the knock put it after.
+    // the knock put it after; the projector's image moved by its drift.
     core::Calibration geometryAt(double seconds) const;
     const cv::Mat& pattern() const { return pattern_; }
     const Scenario& scenario() const { return *scenario_; }
@@ -78,10 +78,19 @@ private:
     void showContent(const SceneState& scene);
     // The content image, scaled to the display.
     void showFixedImage();
-    // The renderer of the camera where it stands before the knock or after it.
-    void placeCamera(bool knocked);
+    // The rig as it stands at `seconds`: where the camera is and how far the projector's image has crept.
+    struct Placement {
+        bool knocked = false;
+        long driftSteps = 0;  // how far the projector's image has crept, in steps of a fiftieth of a pixel
+        bool operator==(const Placement&) const = default;
+    };
+    Placement placementAt(double seconds) const;
+    // The renderer of the rig as it stands at `seconds`.
+    void placeRig(double seconds);
     // The camera's pose after the knock (SimParameters::knockS).
     Eigen::Isometry3d knockedTableToCamera() const;
+    // The unit direction, in projector pixels, in which the projector's image creeps.
+    Eigen::Vector2d driftDirection() const;
     // Largest distance a wrist or fingertip moves between two scenes, mm.
     static double travelMm(const SceneState& from, const SceneState& to);
 
@@ -99,7 +108,7 @@ private:
     std::uint64_t nextIndex_ = 0;       // the frame after the last one rendered
     std::optional<double> userStartS_;  // stream time of the first projected image
     cv::Mat projectorImage_;            // shown instead of the content when not empty
-    bool knocked_ = false;              // the renderer sees through the knocked camera
+    Placement placed_;                  // the rig the renderer shows
 };
 
 }  // namespace everytouch::sim

@@ -277,6 +277,25 @@ TEST(CalibrationCorrector, RefusesAMisregistrationNoMoveOfTheCameraExplains) {
     EXPECT_EQ(waiting.problem(), "");
 }
 
+TEST(CalibrationCorrector, WatchesWithoutAProblemWhatAMoveExplainsButNotYetBeyondTheNoise) {
+    const Rendered& rig = calibratedRig();
+    const Checked checked = check(rig, kRenderedPairs);
+    ASSERT_EQ(checked.tiles.size(), 16u);
+    // The code a third of a pixel off as one small move of the camera would put it (a projector's image that
+    // crept a few seconds), read with a tenth of a pixel of noise: a move explains most of it, but not yet
+    // three times the noise, and what it leaves is within what a calibration may be off by.
+    std::vector<TileShift> crept = checked.tiles;
+    cv::RNG rng(7);
+    for (TileShift& tile : crept)
+        tile.cameraPx = Eigen::Vector2d(0.3 + rng.gaussian(0.1), rng.gaussian(0.1));
+    CalibrationCorrector corrector;
+    corrector.setRig(rig.calibration, 16);
+    for (int round = 1; round <= 3; ++round) {
+        EXPECT_FALSE(corrector.update(16 * round, crept)) << "round " << round;
+        EXPECT_EQ(corrector.problem(), "") << "round " << round;
+    }
+}
+
 TEST(CorrectionOptions, ValidateNamesTheField) {
     CorrectionOptions options;
     EXPECT_FALSE(options.validate());

@@ -1,4 +1,5 @@
-// The simulated camera knocked after the calibration: what moves and what stays.
+// The simulated rig moving after its calibration (a knocked camera, a creeping projector image): what moves
+// and what stays.
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -6,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/geometry.h"
 #include "sim/sim_options.h"
 #include "sim/simulator.h"
 
@@ -76,6 +78,55 @@ TEST(SimKnock, FramesAfterTheKnockShowTheTableFromWhereTheCameraNowIs) {
     EXPECT_EQ(differs(0), 0.0);
 }
 
+TEST(SimDrift, TheProjectorsImageCreepsAtTheSpecsRateWhileTheCalibrationStays) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockS.reset();
+    parameters.driftPxPerMin = 6.0;
+    const Simulator simulator(parameters, rigPattern(parameters));
+    const core::Calibration& calibration = simulator.calibration();
+    EXPECT_TRUE(simulator.geometryAt(0.0).projectorMatrix.isApprox(calibration.projectorMatrix));
+    // 6 px a minute: 1 px after 10 s, 2 px after 20 s, in one direction, to within its steps.
+    const auto crept = [&](double seconds) {
+        const core::Calibration now = simulator.geometryAt(seconds);
+        EXPECT_TRUE(now.tableToCamera.isApprox(calibration.tableToCamera));
+        EXPECT_TRUE(now.tableToProjector.isApprox(calibration.tableToProjector));
+        return Eigen::Vector2d(now.projectorMatrix(0, 2) - calibration.projectorMatrix(0, 2),
+                               now.projectorMatrix(1, 2) - calibration.projectorMatrix(1, 2));
+    };
+    const Eigen::Vector2d after10 = crept(10.0), after20 = crept(20.0);
+    EXPECT_NEAR(after10.norm(), 1.0, 0.02);
+    EXPECT_NEAR(after20.norm(), 2.0, 0.02);
+    EXPECT_NEAR(after10.normalized().dot(after20.normalized()), 1.0, 1e-9);
+    // The truth follows the image: the display pixel over a table point moves with it.
+    const Eigen::Vector2d onTable(150.0, 100.0);
+    const double movedPx =
+        (core::applyHomography(simulator.geometryAt(20.0).displayToTableHomography().inverse(), onTable) -
+         core::applyHomography(calibration.displayToTableHomography().inverse(), onTable))
+            .norm();
+    EXPECT_GT(movedPx, 1.0);
+}
+
+TEST(SimDrift, FramesShowTheCodeWhereTheImageHasCrept) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockS.reset();
+    parameters.driftPxPerMin = 60.0;  // 1 px a second
+    const cv::Mat pattern = rigPattern(parameters);
+    Simulator simulator(parameters, pattern);
+    SimParameters still = parameters;
+    still.driftPxPerMin = 0.0;
+    Simulator held(still, pattern);
+    core::Frame frame, reference;
+    FrameTruth truth;
+    const auto differs = [&](std::uint64_t index) {
+        simulator.render(index, frame, truth);
+        held.render(index, reference, truth);
+        return cv::norm(frame.image, reference.image, cv::NORM_L1) / static_cast<double>(frame.image.total());
+    };
+    EXPECT_EQ(differs(0), 0.0);
+    EXPECT_GT(differs(240), 1.0);  // 2 s: the code and the content 2 px away
+    EXPECT_EQ(differs(0), 0.0);    // and the first frame again as it was
+}
+
 TEST(SimKnock, SpecKeysAreReadAndChecked) {
     SimParameters p;
     EXPECT_EQ(applyOption(p, "knock", "12.5"), std::nullopt);
@@ -93,6 +144,11 @@ TEST(SimKnock, SpecKeysAreReadAndChecked) {
     p = SimParameters();
     p.knockMm = -2.0;
     EXPECT_NE(p.validate().value_or("").find("knock_mm"), std::string::npos);
+    p = SimParameters();
+    EXPECT_EQ(applyOption(p, "drift_px_per_min", "2"), std::nullopt);
+    EXPECT_EQ(p.driftPxPerMin, 2.0);
+    p.driftPxPerMin = 61.0;
+    EXPECT_NE(p.validate().value_or("").find("drift_px_per_min"), std::string::npos);
 }
 
 }  // namespace
