@@ -108,7 +108,9 @@ struct TrackerOptions {
 //   favours the table. A frame without a height whose code does not favour the table, right after a height
 //   above the touch height, lifts a touching finger at once: it was seen leaving the table, and nothing
 //   puts it back (the two frames running of the debouncing). An observation without a height moves only a
-//   touching track (its point lies on the table) and starts no track; an implausible one moves none.
+//   touching track (its point lies on the table) and starts no track; an implausible one moves none. A
+//   hovering track without a height for more than maxUnmeasuredFrames frames running is not reported until
+//   one is read again: neither its place nor its height is known.
 // - Debouncing: a change needs its condition in two observed frames running; a touch-down also in one frame
 //   when the height is below the touch height by max(minHysteresisMm, decisiveSigmas * sigma). So a
 //   touch-down is reported in the first frame that meets its condition when the evidence is decisive, and

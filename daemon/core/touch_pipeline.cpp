@@ -288,7 +288,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         // tracker uses it only for a finger that touches.
         if (observation.visible.valid)
             observation.padHeightMm = observation.visible.padHeightMm;
-        // The contact point: the pad, seen through the plane of its height.
+        // The contact point: the display pixel straight below the pad, at the height it was read.
         const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
             applyHomography(calibration.cameraToDisplayBelowHomography(observation.padHeightMm), undistorted);

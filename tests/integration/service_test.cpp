@@ -287,6 +287,48 @@ TEST_F(ServiceTest, CalibrationErrorIsAFractionOfAPixelWhileTheCalibrationHolds)
     EXPECT_THAT(status.out, HasSubstr(" projector px\n"));
 }
 
+// The CalibrationCorrected signals of the daemon, heard on a connection of the test's own.
+class CorrectionSignals {
+public:
+    CorrectionSignals() {
+        sd_bus* raw = nullptr;
+        if (sd_bus_open_system(&raw) < 0)
+            return;
+        bus_.reset(raw);
+        sd_bus_slot* slot = nullptr;
+        if (sd_bus_match_signal(bus_.get(), &slot, bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                bus::kSignalCalibrationCorrected, onSignal, this) >= 0)
+            match_.reset(slot);
+    }
+    bool listening() const { return match_ != nullptr; }
+
+    // Takes the signals that come for `duration`, or until the first when `untilOne`.
+    void listen(std::chrono::steady_clock::duration duration, bool untilOne) {
+        const auto deadline = std::chrono::steady_clock::now() + duration;
+        while (!(untilOne && signals > 0) && std::chrono::steady_clock::now() < deadline)
+            if (sd_bus_process(bus_.get(), nullptr) == 0)
+                sd_bus_wait(bus_.get(), 100'000);
+    }
+
+    int signals = 0;
+    double beforePx = 0.0, afterPx = 0.0;  // of the last
+    std::string what;
+
+private:
+    static int onSignal(sd_bus_message* message, void* userdata, sd_bus_error*) {
+        auto& seen = *static_cast<CorrectionSignals*>(userdata);
+        const char* what = nullptr;
+        if (sd_bus_message_read(message, "dds", &seen.beforePx, &seen.afterPx, &what) >= 0) {
+            seen.what = what;
+            ++seen.signals;
+        }
+        return 0;
+    }
+
+    io::Bus bus_;
+    io::BusSlot match_;
+};
+
 TEST_F(ServiceTest, ACameraKnockedAfterTheCalibrationIsCorrectedSavedAndAnnounced) {
     // Half a degree and 2 mm (the simulator's knock) one second in, with the calibration from before in the
     // calibration file.
@@ -294,36 +336,10 @@ TEST_F(ServiceTest, ACameraKnockedAfterTheCalibrationIsCorrectedSavedAndAnnounce
     io::writeCalibrationFile(dir_ / "calibration.yml", before);
     const std::string saved = test::fileContents(dir_ / "calibration.yml");
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\n");
-    sd_bus* raw = nullptr;
-    ASSERT_GE(sd_bus_open_system(&raw), 0);
-    const io::Bus listener(raw);
-    struct Corrected {
-        int signals = 0;
-        double beforePx = 0.0, afterPx = 0.0;
-        std::string what;
-    } corrected;
-    sd_bus_slot* slot = nullptr;
-    ASSERT_GE(sd_bus_match_signal(
-                  listener.get(), &slot, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                  bus::kSignalCalibrationCorrected,
-                  [](sd_bus_message* message, void* userdata, sd_bus_error*) {
-                      auto& seen = *static_cast<Corrected*>(userdata);
-                      const char* what = nullptr;
-                      if (sd_bus_message_read(message, "dds", &seen.beforePx, &seen.afterPx, &what) >= 0) {
-                          seen.what = what;
-                          ++seen.signals;
-                      }
-                      return 0;
-                  },
-                  &corrected),
-              0);
-    const io::BusSlot match(slot);
+    CorrectionSignals corrected;
+    ASSERT_TRUE(corrected.listening());
     startDaemonOn("sim:grid35,knock=1");
-    const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
-    while (corrected.signals == 0 && std::chrono::steady_clock::now() < deadline) {
-        if (sd_bus_process(listener.get(), nullptr) == 0)
-            sd_bus_wait(listener.get(), 100'000);
-    }
+    corrected.listen(kStartTimeout, true);
     ASSERT_EQ(corrected.signals, 1) << "no CalibrationCorrected";
     RecordProperty("before_px", std::to_string(corrected.beforePx));
     RecordProperty("after_px", std::to_string(corrected.afterPx));
@@ -357,21 +373,8 @@ TEST_F(ServiceTest, WithTheCorrectionSwitchedOffAKnockedCameraIsShownAndLeftAsIt
     io::writeCalibrationFile(dir_ / "calibration.yml", sim::rigCalibration(sim::SimParameters{}));
     const std::string saved = test::fileContents(dir_ / "calibration.yml");
     writeConfig("[Calibration]\nPath=" + (dir_ / "calibration.yml").string() + "\nCorrect=no\n");
-    sd_bus* raw = nullptr;
-    ASSERT_GE(sd_bus_open_system(&raw), 0);
-    const io::Bus listener(raw);
-    int corrections = 0;
-    sd_bus_slot* slot = nullptr;
-    ASSERT_GE(sd_bus_match_signal(
-                  listener.get(), &slot, bus::kBusName, bus::kObjectPath, bus::kInterface,
-                  bus::kSignalCalibrationCorrected,
-                  [](sd_bus_message*, void* userdata, sd_bus_error*) {
-                      ++*static_cast<int*>(userdata);
-                      return 0;
-                  },
-                  &corrections),
-              0);
-    const io::BusSlot match(slot);
+    CorrectionSignals corrected;
+    ASSERT_TRUE(corrected.listening());
     startDaemonOn("sim:grid35,knock=0.5");
     // The check shows the knock (3 px on this rig), and goes on showing it: nothing corrects it.
     const auto deadline = std::chrono::steady_clock::now() + kStartTimeout;
@@ -381,11 +384,8 @@ TEST_F(ServiceTest, WithTheCorrectionSwitchedOffAKnockedCameraIsShownAndLeftAsIt
         std::this_thread::sleep_for(100ms);
     }
     ASSERT_GT(error, 2.0);
-    const auto watched = std::chrono::steady_clock::now() + 2s;
-    while (std::chrono::steady_clock::now() < watched)
-        if (sd_bus_process(listener.get(), nullptr) == 0)
-            sd_bus_wait(listener.get(), 100'000);
-    EXPECT_EQ(corrections, 0);
+    corrected.listen(2s, false);
+    EXPECT_EQ(corrected.signals, 0);
     EXPECT_GT(measuredCalibrationError([&] { return get("CalibrationErrorPx"); }), 2.0);
     EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), saved);
     EXPECT_FALSE(std::filesystem::exists(dir_ / "calibration.yml.bak"));

@@ -70,6 +70,30 @@ std::string addError(SnapshotRequests& requests, int fd, Answers& answers) {
     return "";
 }
 
+// A pipeline whose first pair takes as long as a new calibration's preparation on a slow machine.
+class SlowFirstPairPipeline final : public core::PairPipeline {
+public:
+    explicit SlowFirstPairPipeline(Clock::duration firstPair) : firstPair_(firstPair) {}
+    const core::PipelineResult& process(const core::FramePair& pair, const core::PipelineSettings&) override {
+        if (pairs_++ == 0)
+            std::this_thread::sleep_for(firstPair_);
+        result_.frameIndex = pair.latest().index;
+        return result_;
+    }
+    void reset() override {}
+
+private:
+    Clock::duration firstPair_;
+    int pairs_ = 0;
+    core::PipelineResult result_;
+};
+
+// How a snapshot was answered, and after how long.
+struct SlowAnswer {
+    Answers answers;
+    Clock::duration waited{};
+};
+
 class SnapshotRequestsTest : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -95,6 +119,26 @@ protected:
 
     io::UniqueFd openForWriting(const std::string& name) {
         return io::UniqueFd(::open((dir_ / name).c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600));
+    }
+
+    // One snapshot asked for while a pipeline whose first pair takes `firstPair` works on it, with a frame
+    // timeout of 100 ms and `busy` beyond it.
+    SlowAnswer snapshotWhileTheFirstPairTakes(Clock::duration firstPair, std::chrono::milliseconds busy) {
+        io::ReplaySource source(dir_ / "recording", false);
+        SlowFirstPairPipeline slow(firstPair);
+        FrameLoop loop(source, slow, {}, nullptr, options_, {}, [] {});
+        MarkingRenderer renderer;
+        SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function(),
+                                  SnapshotTimeouts{100ms, 3000ms, busy});
+        loop.start();
+        SlowAnswer answer;
+        EXPECT_TRUE(runUntil([&] { return loop.processing(); }, 10s));
+        io::UniqueFd fd = openForWriting("snapshot.png");
+        const auto begun = Clock::now();
+        requests.add(SnapshotKind::Camera, fd.get(), answer.answers.reply());
+        EXPECT_TRUE(runUntil([&] { return answer.answers.done + answer.answers.failures.size() > 0; }, 10s));
+        answer.waited = Clock::now() - begun;
+        return answer;
     }
 
     test::TempDir dir_;
@@ -156,57 +200,18 @@ TEST_F(SnapshotRequestsTest, WithoutFramesTheRequestFailsAfterItsTimeoutAndStays
     EXPECT_EQ(std::filesystem::file_size(dir_ / "snapshot.png"), 0u);
 }
 
-// A pipeline whose first pair takes as long as a new calibration's preparation on a slow machine.
-class SlowFirstPairPipeline final : public core::PairPipeline {
-public:
-    explicit SlowFirstPairPipeline(Clock::duration firstPair) : firstPair_(firstPair) {}
-    const core::PipelineResult& process(const core::FramePair& pair, const core::PipelineSettings&) override {
-        if (pairs_++ == 0)
-            std::this_thread::sleep_for(firstPair_);
-        result_.frameIndex = pair.latest().index;
-        return result_;
-    }
-    void reset() override {}
+TEST_F(SnapshotRequestsTest, WaitsForAPairDetectionIsStillWorkingOn) {
+    const SlowAnswer answer = snapshotWhileTheFirstPairTakes(400ms, 1000ms);
+    EXPECT_EQ(answer.answers.done, 1)
+        << (answer.answers.failures.empty() ? "" : answer.answers.failures.front().second);
+}
 
-private:
-    Clock::duration firstPair_;
-    int pairs_ = 0;
-    core::PipelineResult result_;
-};
-
-TEST_F(SnapshotRequestsTest, WaitsForAPairDetectionIsStillWorkingOnAndNoLonger) {
-    io::ReplaySource source(dir_ / "recording", false);
-    SlowFirstPairPipeline slow(400ms);
-    FrameLoop loop(source, slow, {}, nullptr, options_, {}, [] {});
-    MarkingRenderer renderer;
-    SnapshotRequests requests(event_.get(), loop, inbox_, renderer.function(),
-                              SnapshotTimeouts{100ms, 3000ms, 1000ms});
-    loop.start();
-    ASSERT_TRUE(runUntil([&] { return loop.processing(); }, 10s));
-    Answers answers;
-    io::UniqueFd fd = openForWriting("snapshot.png");
-    requests.add(SnapshotKind::Camera, fd.get(), answers.reply());
-    ASSERT_TRUE(runUntil([&] { return answers.done + answers.failures.size() > 0; }, 10s));
-    EXPECT_EQ(answers.done, 1) << (answers.failures.empty() ? "" : answers.failures.front().second);
-    ASSERT_TRUE(runUntil([&] { return loop.finished(); }, 30s));
-
-    // A pair that takes longer than the frame's timeout and the wait beyond it together is not waited for.
-    io::ReplaySource again(dir_ / "recording", false);
-    SlowFirstPairPipeline slower(2s);
-    FrameLoop stuck(again, slower, {}, nullptr, options_, {}, [] {});
-    SnapshotRequests patient(event_.get(), stuck, inbox_, renderer.function(),
-                             SnapshotTimeouts{100ms, 3000ms, 300ms});
-    stuck.start();
-    ASSERT_TRUE(runUntil([&] { return stuck.processing(); }, 10s));
-    Answers late;
-    io::UniqueFd second = openForWriting("late.png");
-    const auto begun = Clock::now();
-    patient.add(SnapshotKind::Camera, second.get(), late.reply());
-    ASSERT_TRUE(runUntil([&] { return late.done + late.failures.size() > 0; }, 10s));
-    EXPECT_GE(Clock::now() - begun, 400ms);
-    ASSERT_EQ(late.failures.size(), 1u);
-    EXPECT_EQ(late.failures.front().first, bus::kErrorBusy);
-    EXPECT_EQ(late.failures.front().second,
+TEST_F(SnapshotRequestsTest, GivesUpOnAPairDetectionWorksOnLongerThanItsWait) {
+    const SlowAnswer answer = snapshotWhileTheFirstPairTakes(2s, 300ms);
+    EXPECT_GE(answer.waited, 400ms);
+    ASSERT_EQ(answer.answers.failures.size(), 1u);
+    EXPECT_EQ(answer.answers.failures.front().first, bus::kErrorBusy);
+    EXPECT_EQ(answer.answers.failures.front().second,
               "Detection has been working on one frame pair for more than 0.3 s");
 }
 

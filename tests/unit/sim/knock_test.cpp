@@ -28,6 +28,27 @@ Eigen::Vector3d centreOf(const Eigen::Isometry3d& tableToDevice) {
     return -(tableToDevice.linear().transpose() * tableToDevice.translation());
 }
 
+// The same frame rendered by a rig that moved and by one that did not, both with the first rig's code: their
+// mean difference, DN per pixel.
+class FrameComparison {
+public:
+    FrameComparison(const SimParameters& moved, const SimParameters& still)
+        : pattern_(rigPattern(moved)), moved_(moved, pattern_), still_(still, pattern_) {}
+
+    double operator()(std::uint64_t index) {
+        moved_.render(index, frame_, truth_);
+        still_.render(index, reference_, truth_);
+        return cv::norm(frame_.image, reference_.image, cv::NORM_L1) /
+               static_cast<double>(frame_.image.total());
+    }
+
+private:
+    cv::Mat pattern_;
+    Simulator moved_, still_;
+    core::Frame frame_, reference_;
+    FrameTruth truth_;
+};
+
 TEST(SimKnock, TurnsAndShiftsTheCameraByTheSpecsAmountsAndLeavesTheCalibration) {
     SimParameters parameters = knockedRig(1.0);
     parameters.knockDeg = 0.8;
@@ -58,20 +79,11 @@ TEST(SimKnock, TheSameSeedKnocksTheSameWayAnotherSeedAnother) {
 
 TEST(SimKnock, FramesAfterTheKnockShowTheTableFromWhereTheCameraNowIs) {
     const SimParameters parameters = knockedRig(0.05);
-    const cv::Mat pattern = rigPattern(parameters);
-    Simulator simulator(parameters, pattern);
     SimParameters still = parameters;
     still.knockS.reset();
-    Simulator unknocked(still, pattern);
-    core::Frame frame, reference;
-    FrameTruth truth;
     // Frames 0 and 2 come before the knock, 8 after it (120 frames/s), each compared with the same frame of
     // the rig that was not knocked; frame 0 again after frame 8 is the frame before the knock again.
-    const auto differs = [&](std::uint64_t index) {
-        simulator.render(index, frame, truth);
-        unknocked.render(index, reference, truth);
-        return cv::norm(frame.image, reference.image, cv::NORM_L1) / static_cast<double>(frame.image.total());
-    };
+    FrameComparison differs(parameters, still);
     EXPECT_EQ(differs(0), 0.0);
     EXPECT_EQ(differs(2), 0.0);
     EXPECT_GT(differs(8), 1.0);  // mean DN per pixel: the table's print and light in other places
@@ -110,18 +122,9 @@ TEST(SimDrift, FramesShowTheCodeWhereTheImageHasCrept) {
     SimParameters parameters = knockedRig(1.0);
     parameters.knockS.reset();
     parameters.driftPxPerMin = 60.0;  // 1 px a second
-    const cv::Mat pattern = rigPattern(parameters);
-    Simulator simulator(parameters, pattern);
     SimParameters still = parameters;
     still.driftPxPerMin = 0.0;
-    Simulator held(still, pattern);
-    core::Frame frame, reference;
-    FrameTruth truth;
-    const auto differs = [&](std::uint64_t index) {
-        simulator.render(index, frame, truth);
-        held.render(index, reference, truth);
-        return cv::norm(frame.image, reference.image, cv::NORM_L1) / static_cast<double>(frame.image.total());
-    };
+    FrameComparison differs(parameters, still);
     EXPECT_EQ(differs(0), 0.0);
     EXPECT_GT(differs(240), 1.0);  // 2 s: the code and the content 2 px away
     EXPECT_EQ(differs(0), 0.0);    // and the first frame again as it was
