@@ -101,6 +101,7 @@ sanitize)
         'HandSegmentation\.TouchingFingertipsKeepTheirEnds'
         'HandSegmentation\.AFingerSlidingFlatOnTheTableKeepsItsWidth'
         'HandSegmentation\.AFingerPassingHighIsFoundInEveryPair'
+        'HandSegmentation\.AnEmptyTableTheCalibrationPutsALittleOffStaysTable'
         'SurfaceHeightRendered\.ASlidingFingertipsHeightIsReadAndKeepsToItsSurface'
         'SurfaceHeightRendered\.AFingertipSeenFromAboveIsReadThroughItsShape'
         'TouchPipelineRendered\.ADragStaysOneTouch'

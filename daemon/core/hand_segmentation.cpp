@@ -205,6 +205,8 @@ std::optional<std::string> SegmentationOptions::validate() const {
         return "smoothingWidths: must be from 0 to 2 finger widths";
     if (!(minElevationMm >= 0.0 && minElevationMm < elevation.maxHeightMm))
         return "minElevationMm: must be from 0 to the highest elevation measured";
+    if (!(misregistrationPx >= 0.0 && misregistrationPx <= 8.0))
+        return "misregistrationPx: must be from 0 to 8 projector pixels";
     if (closingRadiusPx < 0)
         return "closingRadiusPx: must not be negative";
     if (auto problem = saliency.validate())
@@ -231,6 +233,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
                                                          kPredictionSharperPx * kPredictionSharperPx))
                            : options_.cameraBlurPx;
     tableCode_ = predictTableCode(calibration, pattern, predictionBlurPx);
+    shiftedCode_.setCode(tableCode_.predicted);
     elevation_.setRig(calibration, pattern);
     evidence_ = CodeEvidence{};
     evidence_.blockPx = options_.blockPx;
@@ -289,6 +292,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     unlitVariances_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
+    sampleBlocks_.reserve(blockCount);
     blocksToHand_.resize(blockCount);
     tableDistance_.resize(blockCount);
     for (int by = reach; by < blocks.height - reach; ++by)
@@ -402,6 +406,7 @@ void HandSegmenter::classifyBlocks(int channels) {
         }
     }
     const float fidelity = std::clamp(quantile(values_, 0.9), 0.0f, 1.0f);
+    fidelity_ = fidelity;
 
     // One standard deviation of a correlation over a window when nothing correlates: neighbouring pixels
     // share light through the blur, about two pixels per independent sample.
@@ -477,23 +482,48 @@ bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
     const int perBlock = blockPx * blockPx;
     const int used = useInterior ? interiorCount : size;
     const int blockStride = std::max(1, used * perBlock / kMaxPixels);
+    sampleBlocks_.clear();
     elevation_.clearPixels();
+    double idealSum = 0.0;
+    int idealCount = 0;
     for (int k = 0, n = 0; k < size; ++k) {
         if (useInterior && !interior(component_[k]))
             continue;
         if (n++ % blockStride)
             continue;
-        const int y0 = component_[k] / cols * blockPx, x0 = component_[k] % cols * blockPx;
-        for (int y = y0; y < y0 + blockPx; ++y)
-            for (int x = x0; x < x0 + blockPx; ++x)
+        const int by = component_[k] / cols, bx = component_[k] % cols;
+        const cv::Point origin(bx * blockPx, by * blockPx);
+        sampleBlocks_.push_back(origin);
+        for (int y = origin.y; y < origin.y + blockPx; ++y)
+            for (int x = origin.x; x < origin.x + blockPx; ++x)
                 elevation_.addPixel(subtraction, x, y);
+        if (const float ideal = narrowIdeal_.at<float>(by, bx); !std::isnan(ideal)) {
+            idealSum += ideal;
+            ++idealCount;
+        }
     }
     // Heights a few millimetres apart: the table and a hand lie ten or more apart.
     const std::size_t stride = std::max<std::size_t>(
         1, static_cast<std::size_t>(std::floor(0.5 * options_.minElevationMm / options_.elevation.stepMm)));
     elevation_.measurePixels(elevationEvidence_, stride);
     const HeightEstimate height = elevation_.estimate(elevationEvidence_);
-    return height.valid && height.heightMm < options_.minElevationMm;
+    if (height.valid && height.heightMm < options_.minElevationMm)
+        return true;
+    // A table the calibration puts a little off shows its code beside the predicted place: as a block, it
+    // passes the table's test there (half the correlation the table reaches at that amplitude).
+    if (idealCount == 0)
+        return false;
+    const double expected = fidelity_ * idealSum / idealCount;
+    const CodeShiftMatch match =
+        shiftedCode_.bestMatch(subtraction, sampleBlocks_, blockPx,
+                               options_.misregistrationPx / tableCode_.projectorPixelsPerCameraPixel);
+    // Chance correlations over the region, at the best of the twenty-odd shifts tried, stay below this many
+    // of their standard deviations: a faint code over dark content must not pass for the table by chance.
+    constexpr double kSearchSignificance = 4.0;
+    const double chance = std::sqrt(2.0 / static_cast<double>(sampleBlocks_.size() * perBlock));
+    if (match.correlation < kSearchSignificance * chance)
+        return false;
+    return match.correlation >= 0.5 * expected;
 }
 
 int HandSegmenter::floodComponent(int start, uchar from, uchar to) {

@@ -12,6 +12,7 @@
 #include "core/mean_shift_segmentation.h"
 #include "core/saliency.h"
 #include "core/segment_confidence.h"
+#include "core/shifted_code_match.h"
 #include "core/surface_height.h"
 #include "core/table_code.h"
 
@@ -48,6 +49,12 @@ struct SegmentationOptions {
     // or more. A region whose code puts it lower is on the table: printed text or a stain that changed the
     // code's look, not a hand.
     double minElevationMm = 4.0;
+    // The calibration may put the table's code this far (projector pixels) from where the table shows it
+    // before the calibration's correction sets it right (core/calibration_correction.h): a camera turned by
+    // 0.15 degrees moves it by up to about 2. A region whose code is the table's within that shift is the
+    // table, not a hand; the code of a hand lies further, by parallax (2 projector pixels are 10 mm of height
+    // on the default rig) and blurred by the skin.
+    double misregistrationPx = 2.0;
     HeightOptions elevation;  // how the height of a region is measured
     // The outline's pixels are decided one by one; a majority vote over a square this many finger widths
     // wide then removes specks and notches narrower than a quarter of a finger (where the paper's method
@@ -105,6 +112,8 @@ private:
     // Returns their number.
     int floodComponent(int start, uchar from, uchar to);
     void keepHandComponents(const cv::Mat& subtraction);
+    // Whether the component (component_, `size` blocks) shows the table's code: at a height below
+    // minElevationMm, or shifted by no more than misregistrationMm.
     bool liesOnTable(const cv::Mat& subtraction, int size);
     // A block's mean colour as colourFeature makes it, measured on first use in a frame: blockFeature is the
     // lookup, inlined where the outline's and the table's samples are read (some 57 000 times a pair with
@@ -149,6 +158,9 @@ private:
     std::vector<float> unlitVariances_;  // of S in each window of unlitWindows_
     std::vector<int> queue_;
     std::vector<int> component_;
+    std::vector<cv::Point> sampleBlocks_;  // the blocks of a component its tests read, top-left pixels
+    ShiftedCodeMatcher shiftedCode_;
+    float fidelity_ = 1.0f;  // the fraction of the ideal correlation the table reaches (classifyBlocks)
     std::vector<int> blocksToHand_;     // block grid: blocks to the nearest hand block (8-connected)
     std::vector<float> tableDistance_;  // block grid: nearestTableColour's, negative until measured
     MajorityScratch majorityScratch_;
