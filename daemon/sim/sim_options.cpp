@@ -177,6 +177,15 @@ const std::vector<OptionEntry>& entries() {
          number(&SimParameters::knockDeg)},
         {{"knock_mm", "how far a knock shifts the camera, in a random direction, mm (default 2)"},
          number(&SimParameters::knockMm)},
+        {{"table_shift",
+          "the table slides this many seconds into the session: it moves by table_shift_mm and turns by "
+          "table_shift_deg in its own plane under the rig, whose calibration stays as it was (default: "
+          "never)"},
+         optionalNumber(&SimParameters::tableShiftS)},
+        {{"table_shift_mm", "how far the table slides, in a random direction, mm (default 5)"},
+         number(&SimParameters::tableShiftMm)},
+        {{"table_shift_deg", "how far the sliding table turns about the vertical, degrees (default 1)"},
+         number(&SimParameters::tableShiftDeg)},
         {{"drift_px_per_min",
           "the projector's image creeps across the table at this rate, in a random direction, projector "
           "pixels per minute, while the calibration stays as it was (default 0)"},

@@ -45,6 +45,10 @@ struct SimParameters {
     std::optional<double> knockS;  // at this session time the camera turns by knockDeg about an axis through
     double knockDeg = 0.5;         // its centre and shifts by knockMm, axis and direction random (seeded)
     double knockMm = 2.0;
+    // --- the table slides on the floor: it moves and turns in its own plane under the rig, which stays ---
+    std::optional<double> tableShiftS;  // at this session time the table slides by tableShiftMm in a random
+    double tableShiftMm = 5.0;          // (seeded) direction and turns by tableShiftDeg about the vertical
+    double tableShiftDeg = 1.0;         // through the display's centre
     // The projector's image creeps across the table at this rate, projector pixels per minute, in a random
     // (seeded) direction, as a warming projector's does; the calibration stays as it was. 0: it holds.
     double driftPxPerMin = 0.0;

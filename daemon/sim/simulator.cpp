@@ -160,6 +160,21 @@ Eigen::Isometry3d Simulator::knockedTableToCamera() const {
     return after;
 }
 
+Eigen::Isometry3d Simulator::tableSlide() const {
+    std::mt19937_64 random(mix(parameters_.seed ^ 0x736C696465ull));
+    const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
+    const double turn = (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * parameters_.tableShiftDeg;
+    const Eigen::Vector2d centre2 = core::applyHomography(
+        calibration_.displayToTableHomography(),
+        Eigen::Vector2d(calibration_.displaySize.width / 2.0, calibration_.displaySize.height / 2.0));
+    const Eigen::Vector3d centre(centre2.x(), centre2.y(), 0.0);
+    Eigen::Isometry3d slide = Eigen::Isometry3d::Identity();
+    slide.linear() = Eigen::AngleAxisd(turn * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    slide.translation() = centre - slide.linear() * centre +
+                          parameters_.tableShiftMm * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
+    return slide;
+}
+
 Eigen::Vector2d Simulator::driftDirection() const {
     std::mt19937_64 random(mix(parameters_.seed ^ 0x6472696674ull));
     const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
@@ -169,6 +184,7 @@ Eigen::Vector2d Simulator::driftDirection() const {
 Simulator::Placement Simulator::placementAt(double seconds) const {
     Placement placement;
     placement.knocked = parameters_.knockS && seconds >= *parameters_.knockS;
+    placement.tableShifted = parameters_.tableShiftS && seconds >= *parameters_.tableShiftS;
     // The image creeps in steps far below what the code or a touch can tell, so that the renderer is set up
     // again every few seconds rather than for every frame, and any frame renders alone as in the stream.
     placement.driftSteps = static_cast<long>(
@@ -181,6 +197,13 @@ core::Calibration Simulator::geometryAt(double seconds) const {
     core::Calibration geometry = calibration_;
     if (placement.knocked)
         geometry.tableToCamera = knockedTableToCamera();
+    // The rig stays where it was, so it stands against the table's new frame as it stood against the old
+    // frame's points the table slid to: the plane, and with it the code's registration, is the same.
+    if (placement.tableShifted) {
+        const Eigen::Isometry3d slide = tableSlide();
+        geometry.tableToCamera = geometry.tableToCamera * slide;
+        geometry.tableToProjector = geometry.tableToProjector * slide;
+    }
     // The panel's image moves over the table as its principal point does.
     const Eigen::Vector2d drift = placement.driftSteps * kDriftStepPx * driftDirection();
     geometry.projectorMatrix(0, 2) += drift.x();

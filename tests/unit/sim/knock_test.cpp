@@ -1,5 +1,5 @@
-// The simulated rig moving after its calibration (a knocked camera, a creeping projector image): what moves
-// and what stays.
+// The simulated rig moving after its calibration (a knocked camera, a creeping projector image, a table that
+// slid): what moves and what stays.
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -130,6 +130,46 @@ TEST(SimDrift, FramesShowTheCodeWhereTheImageHasCrept) {
     EXPECT_EQ(differs(0), 0.0);    // and the first frame again as it was
 }
 
+TEST(SimTableShift, TheTableSlidesAndTurnsInItsPlaneAndTheCodeStaysWhereTheCalibrationPutsIt) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockS.reset();
+    parameters.tableShiftS = 1.0;
+    parameters.tableShiftMm = 5.0;
+    parameters.tableShiftDeg = 1.0;
+    const Simulator simulator(parameters, rigPattern(parameters));
+    const core::Calibration& calibration = simulator.calibration();
+    const core::Calibration before = simulator.geometryAt(0.99), after = simulator.geometryAt(1.0);
+    EXPECT_TRUE(before.tableToCamera.isApprox(calibration.tableToCamera));
+    // The rig stands against the table as if the table had moved 5 mm and turned 1 degree about the vertical
+    // through the display's centre: that centre moved by the slide alone.
+    const Eigen::Isometry3d relative = before.tableToCamera.inverse() * after.tableToCamera;
+    EXPECT_NEAR(Eigen::AngleAxisd(relative.linear()).angle() * 180.0 / M_PI, 1.0, 1e-9);
+    EXPECT_NEAR(std::abs(Eigen::AngleAxisd(relative.linear()).axis().z()), 1.0, 1e-9);
+    const Eigen::Vector2d centre = core::applyHomography(
+        calibration.displayToTableHomography(),
+        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector3d centre3(centre.x(), centre.y(), 0.0);
+    EXPECT_NEAR((relative * centre3 - centre3).norm(), 5.0, 1e-9);
+    EXPECT_NEAR((relative * centre3 - centre3).z(), 0.0, 1e-9);
+    EXPECT_TRUE((before.tableToProjector.inverse() * after.tableToProjector).isApprox(relative));
+    // The table's plane is where it was: the code falls where the calibration predicts it.
+    EXPECT_TRUE(after.projectorToCameraHomography().normalized().isApprox(
+        calibration.projectorToCameraHomography().normalized(), 1e-9));
+}
+
+TEST(SimTableShift, FramesAfterTheSlideShowTheTablesPrintMovedAndTheCodeInPlace) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockS.reset();
+    parameters.surface = SurfaceKind::Artifacts;  // print and stains that move with the table
+    parameters.tableShiftS = 0.05;
+    SimParameters still = parameters;
+    still.tableShiftS.reset();
+    FrameComparison differs(parameters, still);
+    EXPECT_EQ(differs(2), 0.0);
+    EXPECT_GT(differs(8), 0.5);  // mean DN per pixel: the print in other places
+    EXPECT_EQ(differs(2), 0.0);
+}
+
 TEST(SimKnock, SpecKeysAreReadAndChecked) {
     SimParameters p;
     EXPECT_EQ(applyOption(p, "knock", "12.5"), std::nullopt);
@@ -152,6 +192,19 @@ TEST(SimKnock, SpecKeysAreReadAndChecked) {
     EXPECT_EQ(p.driftPxPerMin, 2.0);
     p.driftPxPerMin = 61.0;
     EXPECT_NE(p.validate().value_or("").find("drift_px_per_min"), std::string::npos);
+    p = SimParameters();
+    EXPECT_EQ(applyOption(p, "table_shift", "3"), std::nullopt);
+    EXPECT_EQ(applyOption(p, "table_shift_mm", "8"), std::nullopt);
+    EXPECT_EQ(applyOption(p, "table_shift_deg", "0.5"), std::nullopt);
+    EXPECT_EQ(p.tableShiftS, 3.0);
+    EXPECT_EQ(p.tableShiftMm, 8.0);
+    EXPECT_EQ(p.tableShiftDeg, 0.5);
+    EXPECT_EQ(p.validate(), std::nullopt);
+    p.tableShiftMm = -1.0;
+    EXPECT_NE(p.validate().value_or("").find("table_shift_mm"), std::string::npos);
+    p = SimParameters();
+    p.tableShiftDeg = 20.0;
+    EXPECT_NE(p.validate().value_or("").find("table_shift_deg"), std::string::npos);
 }
 
 }  // namespace
