@@ -130,7 +130,7 @@ void ContactTracker::update(std::int64_t timestampUs, const std::vector<FingerOb
         // still between a pair's two frames: one rising from a tap at 0.3 m/s shows none for ten frames.
         // Its last height and place would be reported long after they stopped being true (0.7 mm for a
         // finger at 30 mm); it is reported again once its height is read, under the same id.
-        if (!track.touching && track.unmeasuredFrames > options_.maxUnmeasuredFrames)
+        if (!track.confirmed || (!track.touching && track.unmeasuredFrames > options_.maxUnmeasuredFrames))
             continue;
         const Eigen::Vector2d& position = track.filter.value();
         contacts.push_back(
@@ -218,6 +218,9 @@ void ContactTracker::observe(Track& track, std::int64_t timestampUs, const Finge
         track.heightMm = finger.padHeightMm;
         track.heightSeenUs = timestampUs;
     }
+    // A new track's first observation is placed here too (seenUs is its start): only a second one confirms
+    // it.
+    track.confirmed = track.confirmed || timestampUs != track.seenUs;
     const double sinceSeenS = static_cast<double>(timestampUs - track.seenUs) * 1e-6;
     track.filter.filter(finger.display, sinceSeenS, filter);
     track.observed = finger.display;

@@ -48,6 +48,12 @@ public:
         return contacts_;
     }
 
+    // Fingers come into view: seen in two frames running, as a new track must be before it is reported.
+    const Contacts& appear(const std::vector<FingerObservation>& fingers, double touchHeightMm = kTouchMm) {
+        (*this)(fingers, touchHeightMm);
+        return (*this)(fingers, touchHeightMm);
+    }
+
     const Contacts& contacts() const { return contacts_; }
     ContactTracker& tracker() { return tracker_; }
     std::int64_t timeUs() const { return timeUs_; }
@@ -64,7 +70,8 @@ const Contact* withId(const Contacts& contacts, std::uint32_t id) {
 }
 
 // Feeds fingers along `paths` (table mm at frame f) with position noise and checks, every frame, that each
-// finger's contact keeps the id it got in the first frame and lies nearer its own finger than any other.
+// finger's contact keeps the id it got in the first frame it was reported in and lies nearer its own finger
+// than any other.
 template <typename Paths>
 void expectIdsKept(int fingerCount, int frames, Paths paths, unsigned seed, double noiseMm = 0.5) {
     std::mt19937 random(seed);
@@ -82,8 +89,13 @@ void expectIdsKept(int fingerCount, int frames, Paths paths, unsigned seed, doub
         // The tracker must not lean on the order the detection lists fingers in.
         std::shuffle(observations.begin(), observations.end(), random);
         const Contacts& contacts = feed(observations);
-        ASSERT_EQ(contacts.size(), static_cast<std::size_t>(fingerCount)) << "frame " << f;
+        // New fingers are reported from the second frame they are seen in.
         if (f == 0) {
+            ASSERT_TRUE(contacts.empty());
+            continue;
+        }
+        ASSERT_EQ(contacts.size(), static_cast<std::size_t>(fingerCount)) << "frame " << f;
+        if (f == 1) {
             for (int i = 0; i < fingerCount; ++i) {
                 auto nearest = std::min_element(
                     contacts.begin(), contacts.end(), [&](const Contact& a, const Contact& b) {
@@ -176,8 +188,10 @@ TEST(ContactTracker, BadInputIsNamed) {
 
 TEST(ContactTracker, NewFingersGetIncreasingIdsThatLastWhileTracked) {
     Feed feed;
-    EXPECT_THAT(feed({finger({50, 50}, 8)}), ::testing::SizeIs(1));
+    EXPECT_THAT(feed.appear({finger({50, 50}, 8)}), ::testing::SizeIs(1));
     EXPECT_EQ(feed.contacts()[0].id, 1u);
+    // A second finger is reported from the second frame it is seen in.
+    EXPECT_THAT(feed({finger({51, 50}, 8), finger({120, 80}, 8)}), ::testing::SizeIs(1));
     feed({finger({51, 50}, 8), finger({120, 80}, 8)});
     ASSERT_EQ(feed.contacts().size(), 2u);
     EXPECT_EQ(feed.contacts()[0].id, 1u);
@@ -189,13 +203,29 @@ TEST(ContactTracker, NewFingersGetIncreasingIdsThatLastWhileTracked) {
         feed({finger({120, 80}, 8)});
     ASSERT_EQ(feed.contacts().size(), 1u);
     EXPECT_EQ(feed.contacts()[0].id, 2u);
-    feed({finger({120, 80}, 8), finger({51, 50}, 8)});
+    feed.appear({finger({120, 80}, 8), finger({51, 50}, 8)});
     EXPECT_EQ(feed.contacts()[1].id, 3u);
+}
+
+TEST(ContactTracker, AFingertipSeenInOneFrameAloneIsNoContact) {
+    // The projected content changing between a pair's two frames draws edges in S that the segmentation may
+    // take for a fingertip, in that pair alone: hovering or touching, nothing is reported.
+    Feed feed;
+    EXPECT_TRUE(feed({finger({50, 50}, 8)}).empty());
+    for (int f = 0; f < 4; ++f)
+        EXPECT_TRUE(feed({}).empty()) << "frame " << f;
+    EXPECT_TRUE(feed({finger({90, 50}, 0)}).empty());
+    for (int f = 0; f < 4; ++f)
+        EXPECT_TRUE(feed({}).empty()) << "frame " << f;
+    // Seen again within the frames a track outlives unseen, it is reported: a finger missed for a frame.
+    feed({finger({50, 50}, 8)});
+    feed({});
+    EXPECT_THAT(feed({finger({50, 50}, 8)}), ::testing::SizeIs(1));
 }
 
 TEST(ContactTracker, AMissedDetectionDoesNotEndATouch) {
     Feed feed;
-    feed({finger({60, 40}, 0)});
+    feed.appear({finger({60, 40}, 0)});
     ASSERT_TRUE(feed.contacts()[0].touching);
     const Contact before = feed.contacts()[0];
     // Two frames without the finger (maxMissedFrames): it is still there, touching, where it was.
@@ -221,7 +251,7 @@ FingerObservation unmeasured(const Eigen::Vector2d& mm) {
 
 TEST(ContactTracker, AFingertipWithoutAHeightKeepsItsTouchForAFewFramesThenLifts) {
     Feed feed;
-    feed({finger({60, 40}, 0)});
+    feed.appear({finger({60, 40}, 0)});
     ASSERT_TRUE(feed.contacts()[0].touching);
     const std::uint32_t id = feed.contacts()[0].id;
     // Found, but the code on it too faint for a height: it slides on, touching, for maxUnmeasuredFrames.
@@ -242,7 +272,7 @@ TEST(ContactTracker, AFingertipWithoutAHeightKeepsItsTouchForAFewFramesThenLifts
 
 TEST(ContactTracker, AFingertipWhoseCodeFavoursTheTableStaysDownWithoutAHeight) {
     Feed feed;
-    feed({finger({60, 40}, 0)});
+    feed.appear({finger({60, 40}, 0)});
     ASSERT_TRUE(feed.contacts()[0].touching);
     // A slide whose code is too faint for a height but still matches the table better than anything higher:
     // it does not count towards the frames that lift a touch.
@@ -262,7 +292,7 @@ TEST(ContactTracker, AFingertipWhoseCodeFavoursTheTableStaysDownWithoutAHeight) 
 
 TEST(ContactTracker, AHoveringFingerWithoutAHeightIsReportedAgainOnlyOnceItHasOne) {
     Feed feed;
-    feed({finger({60, 40}, 10.0)});
+    feed.appear({finger({60, 40}, 10.0)});
     ASSERT_EQ(feed.contacts().size(), 1u);
     const std::uint32_t id = feed.contacts()[0].id;
     // A rising finger whose code the pair's two frames do not agree on: its last height holds for as many
@@ -283,7 +313,7 @@ TEST(ContactTracker, AHoveringFingerWithoutAHeightIsReportedAgainOnlyOnceItHasOn
 
 TEST(ContactTracker, AHeightAboveTheTouchHeightThenNoCodeNearTheTableLiftsAtOnce) {
     Feed feed;
-    feed({finger({60, 40}, 0)});
+    feed.appear({finger({60, 40}, 0)});
     ASSERT_TRUE(feed.contacts()[0].touching);
     // Above the touch height but within the band: still touching.
     feed({finger({60, 40}, kTouchMm + 1.0)});
@@ -329,16 +359,16 @@ TEST(ContactTracker, APendingTouchDownOutlivesNoMoreFramesWithoutAHeightThanATou
 
 TEST(ContactTracker, AFingertipWithoutAHeightStartsNoContact) {
     Feed feed;
+    EXPECT_TRUE(feed.appear({unmeasured({60, 40})}).empty());
     EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
-    EXPECT_TRUE(feed({unmeasured({60, 40})}).empty());
-    EXPECT_EQ(feed({finger({60, 40}, 20)}).size(), 1u);
+    EXPECT_EQ(feed.appear({finger({60, 40}, 20)}).size(), 1u);
 }
 
 TEST(ContactTracker, AJumpFasterThanAFingerIsAnotherFinger) {
     Feed feed;
-    feed({finger({60, 40}, 0)});
+    feed.appear({finger({60, 40}, 0)});
     // 2 m/s for one frame is 16.7 mm; 40 mm is no finger's move.
-    feed({finger({100, 40}, 0)});
+    feed.appear({finger({100, 40}, 0)});
     ASSERT_EQ(feed.contacts().size(), 2u);
     EXPECT_EQ(feed.contacts()[0].id, 1u);  // held for its grace frames
     EXPECT_EQ(feed.contacts()[1].id, 2u);
@@ -430,8 +460,10 @@ TEST(ContactTracker, AFastFingerMissedForAFrameKeepsItsId) {
             feed({finger(front, 0)});
         else
             feed({finger(rear, 0), finger(front, 0)});
+        if (f == 0)
+            continue;  // new fingers are reported from the second frame they are seen in
         ASSERT_EQ(feed.contacts().size(), 2u);
-        if (f == 0) {
+        if (f == 1) {
             rearId = feed.contacts()[0].id;
             frontId = feed.contacts()[1].id;
         }
@@ -473,6 +505,9 @@ int touchChanges(Feed& feed, const std::vector<double>& heights, double sigmaMm,
                  std::vector<bool>* states = nullptr) {
     int changes = 0;
     bool touching = false;
+    // The finger came into view a frame before: a new track is reported from its second frame.
+    if (!heights.empty())
+        feed({finger({100, 100}, heights.front(), sigmaMm)});
     for (const double height : heights) {
         const Contacts& contacts = feed({finger({100, 100}, height, sigmaMm)});
         const bool now = !contacts.empty() && contacts[0].touching;
@@ -570,7 +605,7 @@ TEST(ContactTracker, AHeightNoFingerReachesInTheTimeIsIgnored) {
 
 TEST(ContactTracker, TheTouchHeightIsTakenEachFrame) {
     Feed feed;
-    feed({finger({100, 100}, 5, 0.2)});
+    feed.appear({finger({100, 100}, 5, 0.2)});
     EXPECT_FALSE(feed.contacts()[0].touching);
     // A more sensitive setting: 5 mm is now 5 mm below it.
     EXPECT_TRUE(feed({finger({100, 100}, 5, 0.2)}, 10.0)[0].touching);
@@ -684,6 +719,8 @@ TEST(ContactTracker, JitterOfARestingFingerIsCutThreefold) {
     for (int f = 0; f < 2400; ++f) {
         const Eigen::Vector2d seen = rest + Eigen::Vector2d(jitter(random), jitter(random));
         const Contacts& contacts = feed({finger(seen, 0.0)});
+        if (f == 0)
+            continue;  // reported from the second frame it is seen in
         ASSERT_EQ(contacts.size(), 1u);
         ASSERT_EQ(contacts[0].id, 1u);
         if (f < 120)
@@ -739,7 +776,7 @@ TEST(ContactTracker, APalmIsNeverATouch) {
         // Resting on the table, and for a few frames read as a finger.
         const bool misread = f >= 10 && f < 14;
         const Contacts& contacts =
-            feed({misread ? finger({150, 180}, 0.0) : palm({150, 180}), finger({60, 60}, 10.0)});
+            feed.appear({misread ? finger({150, 180}, 0.0) : palm({150, 180}), finger({60, 60}, 10.0)});
         ASSERT_EQ(contacts.size(), 2u);
         EXPECT_EQ(contacts[0].id, 1u);
         EXPECT_TRUE(contacts[0].palm) << "frame " << f;
@@ -751,7 +788,7 @@ TEST(ContactTracker, APalmIsNeverATouch) {
 
 TEST(ContactTracker, ATouchTurningIntoAPalmKeepsItsSlotAsAPalm) {
     Feed feed;
-    feed({finger({150, 180}, 0.0)});
+    feed.appear({finger({150, 180}, 0.0)});
     ASSERT_TRUE(feed.contacts()[0].touching);
     const std::uint32_t id = feed.contacts()[0].id;
     // The hand flattens: the detection now sees a palm there.
@@ -773,11 +810,13 @@ TEST(ContactTracker, ATouchTurningIntoAPalmKeepsItsSlotAsAPalm) {
 
 TEST(ContactTracker, ResetForgetsEveryContact) {
     Feed feed;
-    feed({finger({50, 50}, 0), finger({90, 50}, 0)});
+    feed.appear({finger({50, 50}, 0), finger({90, 50}, 0)});
     feed.tracker().reset();
     Contacts contacts;
     // Any timestamp is taken after a reset, even an earlier one; the fingers come back with new ids.
     feed.tracker().update(1000, {finger({50, 50}, 0)}, kTouchMm, kPxPerMm, contacts);
+    EXPECT_TRUE(contacts.empty());
+    feed.tracker().update(1000 + kFrameUs, {finger({50, 50}, 0)}, kTouchMm, kPxPerMm, contacts);
     ASSERT_EQ(contacts.size(), 1u);
     EXPECT_EQ(contacts[0].id, 3u);
 }
