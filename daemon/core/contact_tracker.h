@@ -126,10 +126,11 @@ struct TrackerOptions {
 //   must not tap). A palm that was a touching finger keeps touching = true until it lifts or ends, so the
 //   touchscreen holds its slot and turns it into MT_TOOL_PALM, which cancels the touch; a touch released
 //   instead would be a tap.
-// - A new track is reported from the second frame it is observed in, like any change of state: a fingertip
-//   found in one pair alone (the projected content changing between the pair's two frames draws edges in S
-//   that nothing on the table shows) is no finger. A finger that appears touching is thus reported at most
-//   one frame late, like a touch-down.
+// - A new track is reported from the second frame that places it (an observation with a plausible height,
+//   or any observation of a touching finger), like any change of state: a fingertip found in one pair
+//   alone (the projected content changing between the pair's two frames draws edges in S that nothing on
+//   the table shows) is no finger. A finger that appears touching is thus reported at most one frame late,
+//   like a touch-down.
 // - At most kMaxContacts contacts are reported, the oldest tracks first; hovering fingers and palms count.
 // - After construction no update allocates while the observations fit maxTracks.
 class ContactTracker {
@@ -172,7 +173,7 @@ private:
         bool touching = false;
         bool palm = false;
         bool pending = false;  // the last observation met the condition for the other touch state, undecided
-        bool confirmed = false;  // observed in a second frame since it began: reported from then on
+        bool confirmed = false;  // placed in a second frame since it began: reported from then on
         RestingLevel resting;    // the pad heights read while it touched
         OneEuroFilter filter;
     };

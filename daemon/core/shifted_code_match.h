@@ -13,8 +13,10 @@ namespace everytouch::core {
 // the table shows it displaced by parallax (1 mm of height moves it some 0.2 projector pixels on a common
 // rig) and, on skin, blurred.
 struct CodeShiftMatch {
-    float correlation = 0.0f;            // the best; 0 without samples
-    float shiftX = 0.0f, shiftY = 0.0f;  // where the code lies against the prediction, camera pixels
+    float correlation = 0.0f;  // the best; 0 without samples
+    // S at a pixel p follows the prediction at p + shift (camera pixels): the code lies -shift from where
+    // the prediction puts it.
+    float shiftX = 0.0f, shiftY = 0.0f;
 };
 
 class ShiftedCodeMatcher {
