@@ -26,6 +26,9 @@ constexpr double kTurnStepRad = 1e-6;
 constexpr double kShiftStepMm = 1e-3;
 // Step of the camera-to-projector map's derivative, camera pixels: the map is smooth over a pixel.
 constexpr double kPixelStep = 0.5;
+// Step of the derivative by the projector image's shift, projector pixels: the shift moves every panel pixel
+// by itself, so the map is linear in it.
+constexpr double kImageStepPx = 0.1;
 // A tile is set aside when the move leaves it this many times the median tile's residual, in at most this
 // many passes: a Gaussian residual's median is 1.18 sigma in two dimensions, so 3.5 medians is 4 sigma.
 constexpr double kOutlierMedians = 3.5;
@@ -45,6 +48,14 @@ Eigen::Isometry3d movedPose(const Eigen::Isometry3d& pose, const Vector6d& move)
 Eigen::Vector2d seenAt(const CameraModel& camera, const Eigen::Isometry3d& pose,
                        const Eigen::Vector3d& point) {
     return camera.project(pose * point);
+}
+
+// The projector's image shifted on its panel by `shiftPx`: its principal point moved.
+Eigen::Matrix3d shiftedImage(const Eigen::Matrix3d& projectorMatrix, const Eigen::Vector2d& shiftPx) {
+    Eigen::Matrix3d shifted = projectorMatrix;
+    shifted(0, 2) += shiftPx.x();
+    shifted(1, 2) += shiftPx.y();
+    return shifted;
 }
 
 }  // namespace
@@ -84,7 +95,8 @@ CalibrationCorrector::TileGeometry CalibrationCorrector::tileGeometry(
         return applyHomography(cameraToProjector, camera.undistortPixel(raw));
     };
     TileGeometry geometry;
-    const Eigen::Vector2d onTable = applyHomography(projectorToTable, lit(tile.centre));
+    geometry.panelPixel = lit(tile.centre);
+    const Eigen::Vector2d onTable = applyHomography(projectorToTable, geometry.panelPixel);
     geometry.tablePoint = Eigen::Vector3d(onTable.x(), onTable.y(), 0.0);
     geometry.observed = tile.centre + tile.cameraPx;
     const Eigen::Vector2d dx = Eigen::Vector2d(kPixelStep, 0.0), dy = Eigen::Vector2d(0.0, kPixelStep);
@@ -99,6 +111,13 @@ void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
     const Eigen::Matrix3d cameraToProjector = calibration.cameraToProjectorHomography();
     const Eigen::Matrix3d projectorToTable = calibration.tableToProjectorHomography().inverse();
     const Eigen::Isometry3d& pose = calibration.tableToCamera;
+    // Where the table points of panel pixels lie once the image shifted by a step along x or y.
+    Eigen::Matrix3d imageSteppedToTable[2];
+    for (int k = 0; k < 2; ++k)
+        imageSteppedToTable[k] = planeToImageHomography(shiftedImage(calibration.projectorMatrix,
+                                                                     kImageStepPx * Eigen::Vector2d::Unit(k)),
+                                                        calibration.tableToProjector, 0.0)
+                                     .inverse();
     terms_.clear();
     for (const TileShift& tile : tiles) {
         const TileGeometry geometry = tileGeometry(camera, cameraToProjector, projectorToTable, tile);
@@ -110,7 +129,14 @@ void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
             derivative.col(k) =
                 (seenAt(camera, movedPose(pose, move), geometry.tablePoint) - predicted) / move[k];
         }
-        terms_.push_back({geometry, geometry.toProjector * derivative,
+        Eigen::Matrix2d imageDerivative;
+        for (int k = 0; k < 2; ++k) {
+            const Eigen::Vector2d stepped = applyHomography(imageSteppedToTable[k], geometry.panelPixel);
+            imageDerivative.col(k) =
+                (seenAt(camera, pose, Eigen::Vector3d(stepped.x(), stepped.y(), 0.0)) - predicted) /
+                kImageStepPx;
+        }
+        terms_.push_back({geometry, geometry.toProjector * derivative, geometry.toProjector * imageDerivative,
                           geometry.toProjector * (geometry.observed - predicted), true, 0.0});
     }
 }
@@ -151,6 +177,36 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMove() {
     fit.beforePx = std::sqrt(squares / n);
     fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
     fit.noisePx = std::sqrt(left / (n - 3.0));
+    fit.residualSquares = left;
+    fit.tiles = used;
+    return fit;
+}
+
+CalibrationCorrector::Fit CalibrationCorrector::fitImageShift(Eigen::Vector2d& shiftPx) const {
+    Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d right = Eigen::Vector2d::Zero();
+    double squares = 0.0;
+    int used = 0;
+    for (const TileTerm& term : terms_) {
+        if (!term.inlier)
+            continue;
+        normal += term.imageOnPanel.transpose() * term.imageOnPanel;
+        right += term.imageOnPanel.transpose() * term.shift;
+        squares += term.shift.squaredNorm();
+        ++used;
+    }
+    shiftPx = normal.ldlt().solve(right);
+    double left = 0.0;
+    for (const TileTerm& term : terms_)
+        if (term.inlier)
+            left += (term.shift - term.imageOnPanel * shiftPx).squaredNorm();
+    const double n = static_cast<double>(used);
+    Fit fit;
+    fit.beforePx = std::sqrt(squares / n);
+    fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
+    fit.noisePx = std::sqrt(left / (n - 1.0));
+    fit.residualSquares = left;
+    fit.tiles = used;
     return fit;
 }
 
@@ -182,12 +238,15 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vecto
 
 double CalibrationCorrector::inlierMisregistrationPx(const Calibration& corrected) const {
     const CameraModel camera{corrected.cameraMatrix, corrected.cameraDistortion};
+    const Eigen::Matrix3d projectorToTable = corrected.tableToProjectorHomography().inverse();
     double squares = 0.0;
     int used = 0;
     for (const TileTerm& term : terms_) {
         if (!term.inlier)
             continue;
-        const Eigen::Vector2d predicted = seenAt(camera, corrected.tableToCamera, term.geometry.tablePoint);
+        const Eigen::Vector2d lit = applyHomography(projectorToTable, term.geometry.panelPixel);
+        const Eigen::Vector2d predicted =
+            seenAt(camera, corrected.tableToCamera, Eigen::Vector3d(lit.x(), lit.y(), 0.0));
         squares += (term.geometry.toProjector * (term.geometry.observed - predicted)).squaredNorm();
         ++used;
     }
@@ -210,19 +269,28 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
             problem_ = why;
         return std::nullopt;
     };
-    const Fit fit = fitMoveRobustly(latest);
+    const Fit move = fitMoveRobustly(latest);
+    Eigen::Vector2d imageShiftPx;
+    const Fit image = fitImageShift(imageShiftPx);
+    // What would count as the calibration holding (below) is what a correction may leave.
+    const double allowedPx =
+        std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0));
+    // The simplest explanation that suffices: a creep corrected as many small moves of the camera adds up to
+    // a pose that no longer fits, while a knock leaves far more than allowedPx after any shift of the image.
+    const bool imageCrept = std::sqrt(image.residualSquares / image.tiles) <= allowedPx;
+    const Fit& fit = imageCrept ? image : move;
     const double notableNoisePx = options_.noiseMultiple * fit.noisePx;
-    if (fit.beforePx < std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0))) {
+    if (fit.beforePx < allowedPx) {
         // The calibration holds: what the tiles show is their noise.
-        heldNoisePx_ = fit.noisePx;
+        heldNoisePx_ = move.noisePx;
         roundsOff_ = 0;
         return std::nullopt;
     }
     char figures[256];
     if (fit.explainedPx < std::max(options_.leastErrorPx, notableNoisePx)) {
-        // What no move of the camera explains is within what the calibration may be off by: the calibration
-        // is a little off, by no more than the tiles' noise shows clearly (a projector's image creeping by
-        // 2 px a minute, seen a few seconds in). It is watched, and corrected once the move stands out.
+        // What neither explains is within what the calibration may be off by: the calibration is a little
+        // off, by no more than the tiles' noise shows clearly (a projector's image creeping by 2 px a minute,
+        // seen a few seconds in). It is watched, and corrected once the explanation stands out.
         if (fit.noisePx < options_.leastErrorPx) {
             roundsOff_ = 0;
             return std::nullopt;
@@ -230,7 +298,8 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
         std::snprintf(
             figures, sizeof figures,
             "the code lies %.2f projector px from where the calibration puts it, and no move of the "
-            "camera explains it: the one that fits best leaves %.2f px",
+            "camera or shift of the projector's image explains it: the one that fits best leaves "
+            "%.2f px",
             fit.beforePx, fit.noisePx);
         return off(figures);
     }
@@ -238,23 +307,28 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     for (std::size_t i = 0; i < latest.size(); ++i)
         if (terms_[i].inlier)
             inliers_.push_back(latest[i]);
-    Result<CameraRelocation> relocation = relocateCamera(*calibration_, inliers_);
-    if (!relocation.ok())
-        return off(relocation.failure().message);
     CalibrationCorrection correction;
     correction.calibration = *calibration_;
-    correction.calibration.tableToCamera = relocation->tableToCamera;
+    if (imageCrept) {
+        correction.calibration.projectorMatrix = shiftedImage(calibration_->projectorMatrix, imageShiftPx);
+        correction.what = "projector";
+    } else {
+        Result<CameraRelocation> relocation = relocateCamera(*calibration_, inliers_);
+        if (!relocation.ok())
+            return off(relocation.failure().message);
+        correction.calibration.tableToCamera = relocation->tableToCamera;
+        correction.what = "camera";
+    }
     correction.beforePx = fit.beforePx;
     correction.afterPx = inlierMisregistrationPx(correction.calibration);
-    correction.what = "camera";
     correction.tiles = static_cast<int>(inliers_.size());
     const double noisePx = heldNoisePx_.value_or(fit.noisePx);
     // What would count as holding is good enough, even beside a very quiet camera's noise.
     if (correction.afterPx > std::max(options_.leastErrorPx, options_.noiseMultiple * noisePx)) {
         std::snprintf(figures, sizeof figures,
-                      "the code lies %.2f projector px from where the calibration puts it, and the camera's "
-                      "new pose would leave %.2f px, more than the %.2f px of noise seen",
-                      correction.beforePx, correction.afterPx, noisePx);
+                      "the code lies %.2f projector px from where the calibration puts it, and the corrected "
+                      "%s would leave %.2f px, more than the %.2f px of noise seen",
+                      correction.beforePx, correction.what.c_str(), correction.afterPx, noisePx);
         return off(figures);
     }
     calibration_ = correction.calibration;

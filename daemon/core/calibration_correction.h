@@ -32,25 +32,30 @@ struct CalibrationCorrection {
     Calibration calibration;  // the corrected one
     double beforePx = 0.0;    // the misregistration over the tiles it rests on, RMS, projector pixels
     double afterPx = 0.0;     // what the corrected calibration leaves of it, RMS, projector pixels
-    std::string what;         // what moved: "camera"
+    std::string what;         // what moved: "camera", or "projector" (its image crept on its panel)
     int tiles = 0;
 };
 
-// Keeps the calibration true when the camera is knocked or its mount sags. After every round of tiles the
-// registration check measures (core/registration_check.h), it fits a small move of the camera against the
-// table to their shifts, by least squares on the shifts each of the camera pose's six parameters would cause
-// (in projector pixels, the scale the code is read in). What the move leaves unexplained is the tiles' noise.
-// When the move explains a misregistration that is large against that noise and against leastErrorPx, the
-// camera's pose is estimated anew from the tiles (core/camera_relocation.h) and kept when it leaves less than
-// leastErrorPx or no more than noiseMultiple times the noise seen while the calibration held (or, before any
-// such round, the noise of this one). The calibration holds while the misregistration stays below
-// leastErrorPx and below noiseMultiple times that noise. A projector's image that creeps over the table moves
-// the code as a small move of the camera would, and is corrected as one: what the camera's pose then says is
-// where it stands against the image. A misregistration that no move of the camera explains, leaving
-// leastErrorPx or more (the table tilted), is not corrected; problem() says why once two rounds running found
-// it. One that a move explains but not yet clearly beyond the noise, leaving less than leastErrorPx, is
-// watched without a problem. Tiles far off the move that fits the others (a peak of chance, a tile read while
-// the camera moved) are set aside first. Pure; a round that finds nothing allocates nothing.
+// Keeps the calibration true when the camera is knocked or its mount sags, or the projector's image creeps as
+// a warm projector's does. After every round of tiles the registration check measures
+// (core/registration_check.h), it fits two explanations to their shifts by least squares (in projector
+// pixels, the scale the code is read in): a small move of the camera against the table (the shifts each of
+// the camera pose's six parameters would cause), and a shift of the projector's image on its panel (its
+// principal point: the same shift of every projector pixel, two parameters). The image's shift is taken
+// whenever what it leaves would count as the calibration holding (below): a small move of the camera also
+// shifts the code nearly evenly, but a creep corrected as many such moves adds up to a pose that no longer
+// fits (the whole table 0.2-0.3 px off after 9 px of creep), while a knocked camera leaves far more after any
+// shift of the image. What the chosen explanation leaves is the tiles' noise. When it explains a
+// misregistration that is large against that noise and against leastErrorPx, the calibration is corrected
+// (the camera's pose estimated anew from the tiles, core/camera_relocation.h; or the projector's principal
+// point moved by the fitted shift) and the correction kept when it leaves less than leastErrorPx or no more
+// than noiseMultiple times the noise seen while the calibration held (or, before any such round, the noise of
+// this one). The calibration holds while the misregistration stays below leastErrorPx and below noiseMultiple
+// times that noise. A misregistration that neither explains, leaving leastErrorPx or more (the table tilted),
+// is not corrected; problem() says why once two rounds running found it. One that an explanation accounts for
+// but not yet clearly beyond the noise, leaving less than leastErrorPx, is watched without a problem. Tiles
+// far off the move that fits the others (a peak of chance, a tile read while the camera moved) are set aside
+// first. Pure; a round that finds nothing allocates nothing.
 class CalibrationCorrector {
 public:
     // Throws std::invalid_argument when options.validate() fails.
@@ -70,14 +75,17 @@ public:
 
 private:
     struct Fit {
-        double beforePx = 0.0;     // RMS shift over the tiles, projector pixels
-        double explainedPx = 0.0;  // RMS of the part a move of the camera explains
-        double noisePx = 0.0;      // RMS per tile of the rest, corrected for the parameters fitted
+        double beforePx = 0.0;         // RMS shift over the tiles, projector pixels
+        double explainedPx = 0.0;      // RMS of the part the explanation accounts for
+        double noisePx = 0.0;          // RMS per tile of the rest, corrected for the parameters fitted
+        double residualSquares = 0.0;  // the rest's sum of squares, projector pixels squared
+        int tiles = 0;                 // inlier tiles fitted
     };
     // What the check measured at one tile, in the terms of a camera pose: the table point the projector
     // lights through the code predicted at the tile's centre, where the camera now sees it, and how camera
     // pixels there map to projector pixels.
     struct TileGeometry {
+        Eigen::Vector2d panelPixel;  // the projector pixel whose code the calibration predicts at the centre
         Eigen::Vector3d tablePoint;
         Eigen::Vector2d observed;
         Eigen::Matrix2d toProjector;
@@ -85,10 +93,11 @@ private:
     static TileGeometry tileGeometry(const CameraModel& camera, const Eigen::Matrix3d& cameraToProjector,
                                      const Eigen::Matrix3d& projectorToTable, const TileShift& tile);
     // One tile's equations in projector pixels: the shift each parameter of the camera's pose would cause,
-    // and the shift measured.
+    // the shift each pixel of the projector image's own shift would cause, and the shift measured.
     struct TileTerm {
         TileGeometry geometry;
         Eigen::Matrix<double, 2, 6> onPanel;
+        Eigen::Matrix2d imageOnPanel;
         Eigen::Vector2d shift;
         bool inlier = true;
         double residualPx = 0.0;  // what the last fit left of the shift
@@ -96,8 +105,10 @@ private:
     void prepareTerms(const std::vector<TileShift>& tiles);
     Fit fitMove();  // over the inlier terms
     Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
+    // The shift of the projector's image on its panel that fits the inlier terms best.
+    Fit fitImageShift(Eigen::Vector2d& shiftPx) const;
     // RMS distance, projector pixels, between each inlier tile's observed place and where `corrected` puts
-    // its table point.
+    // the table point its panel pixel lights.
     double inlierMisregistrationPx(const Calibration& corrected) const;
 
     CorrectionOptions options_;

@@ -268,13 +268,72 @@ TEST(CalibrationCorrector, RefusesAMisregistrationNoMoveOfTheCameraExplains) {
     EXPECT_FALSE(corrector.update(16, scattered));
     EXPECT_EQ(corrector.problem(), "") << "told after one round";
     EXPECT_FALSE(corrector.update(32, scattered));
-    EXPECT_NE(corrector.problem().find("no move of the camera explains it"), std::string::npos)
+    EXPECT_NE(corrector.problem().find("no move of the camera or shift of the projector's image explains it"),
+              std::string::npos)
         << corrector.problem();
     // Too few tiles for a round: nothing is judged yet.
     CalibrationCorrector waiting;
     waiting.setRig(rig.calibration, 16);
     EXPECT_FALSE(waiting.update(15, scattered));
     EXPECT_EQ(waiting.problem(), "");
+}
+
+// `tiles` as they read when the calibration is `believed` and the rig `real`: the code `believed` predicts
+// at each tile's centre lights the table point `real` puts it on, and the camera sees that point where both
+// say. With `noisePx` camera pixels of noise.
+void readTiles(const Calibration& believed, const Calibration& real, double noisePx, cv::RNG& rng,
+               std::vector<TileShift>& tiles) {
+    const CameraModel camera{believed.cameraMatrix, believed.cameraDistortion};
+    const Eigen::Matrix3d realToTable = real.tableToProjectorHomography().inverse();
+    for (TileShift& tile : tiles) {
+        const Eigen::Vector2d panel =
+            applyHomography(believed.cameraToProjectorHomography(), camera.undistortPixel(tile.centre));
+        const Eigen::Vector2d lit = applyHomography(realToTable, panel);
+        const Eigen::Vector2d seen =
+            camera.project(real.tableToCamera * Eigen::Vector3d(lit.x(), lit.y(), 0.0));
+        tile.cameraPx = seen - tile.centre + Eigen::Vector2d(rng.gaussian(noisePx), rng.gaussian(noisePx));
+    }
+}
+
+TEST(CalibrationCorrector, CorrectsACreepingProjectorsImageAsAShiftOnItsPanelAndTheCreepAddsUp) {
+    const Rendered& rig = calibratedRig();
+    std::vector<TileShift> tiles = check(rig, kRenderedPairs).tiles;
+    ASSERT_EQ(tiles.size(), 16u);
+    CalibrationCorrector corrector;
+    corrector.setRig(rig.calibration, 16);
+    // The image creeps by 0.6 px a round (its principal point moves, as the simulator's drift moves it),
+    // each round read against the correction before, with a twentieth of a camera pixel of noise: twenty
+    // rounds of it (12 px, six minutes at 2 px a minute).
+    const Eigen::Vector2d step(0.5, -0.33);
+    Calibration believed = rig.calibration, real = rig.calibration;
+    cv::RNG rng(11);
+    int corrections = 0, ofTheImage = 0;
+    for (int round = 1; round <= 20; ++round) {
+        real.projectorMatrix(0, 2) += step.x();
+        real.projectorMatrix(1, 2) += step.y();
+        readTiles(believed, real, 0.05, rng, tiles);
+        const std::optional<CalibrationCorrection> correction = corrector.update(16 * round, tiles);
+        if (!correction)
+            continue;
+        ++corrections;
+        EXPECT_LT(correction->afterPx, 0.1) << "round " << round;
+        if (correction->what == "projector") {
+            ++ofTheImage;
+            // Nothing else changed.
+            EXPECT_TRUE(correction->calibration.tableToCamera.isApprox(believed.tableToCamera));
+            EXPECT_TRUE(correction->calibration.tableToProjector.isApprox(believed.tableToProjector));
+        }
+        believed = correction->calibration;
+    }
+    EXPECT_GE(corrections, 15);
+    EXPECT_EQ(ofTheImage, corrections);
+    // The last correction left the code where the calibration predicts it, over the whole table.
+    readTiles(believed, real, 0.0, rng, tiles);
+    double squares = 0.0;
+    for (const TileShift& tile : tiles)
+        squares += tile.cameraPx.squaredNorm();
+    EXPECT_LT(std::sqrt(squares / static_cast<double>(tiles.size())), 0.1);
+    EXPECT_EQ(corrector.problem(), "");
 }
 
 TEST(CalibrationCorrector, WatchesWithoutAProblemWhatAMoveExplainsButNotYetBeyondTheNoise) {
