@@ -162,6 +162,13 @@ sanitize)
         'CameraServiceTest\.CalibratesTheTableThroughItsProjectorWindow'
         'CameraServiceTest\.ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessboard'
         'CameraServiceTest\.AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration'
+        # Measurements the normal build makes (9-11 s each): no allocation per pair over rendered pairs (the
+        # pipeline runs under the sanitizers in its own cases), the bit error rate over delta and noise, and
+        # a recording's segmentation scored pair by pair (the scoring's units run).
+        'SteadyStateAllocation\.ThePipelineAllocatesNothingPerPairOnceWarm'
+        'SteadyStateAllocation\.AStillSceneAllocatesNothingEither'
+        'Decoding\.BitErrorRateFallsWithDeltaAndRisesWithNoise'
+        'EvaluateSegmentation\.ScoresEveryPairAndTheFingertipsOnEachMask'
         # The installed files' checks run systemd-analyze, cmake --install, cpack, lintian and mandoc, none of
         # our code.
         'SystemFiles\.TheUnitVerifies'
