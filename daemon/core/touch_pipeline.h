@@ -102,8 +102,12 @@ struct PipelineResult {
     // Set in the pair after which the pipeline works with a corrected calibration (the camera moved): it goes
     // on with it, contacts and all, for as long as its settings hold the calibration it corrected.
     std::optional<CalibrationCorrection> correction;
-    // Why a calibration the code shows to be off was not corrected; empty otherwise.
+    // Why a calibration the code shows to be off was not corrected, or why no contact is reported while it
+    // is off (heldBack); empty otherwise.
     std::string calibrationProblem;
+    // The code lies further from where the calibration puts it than the table can be told from a hand at:
+    // no contact is reported until it is corrected (fingertips are still found).
+    bool heldBack = false;
 };
 
 // The seam between the frame loop and detection: one call per frame pair on the pipeline thread.
@@ -141,6 +145,8 @@ private:
     // prepared for it and the code's blur measured again, while the tracks and their contacts stay.
     void adoptCorrection(const CalibrationCorrection& correction, const PipelineSettings& settings);
     void prepareFingertips(const Calibration& calibration);
+    // heldBackBeyondPx_ for this calibration (after the segmenter's).
+    void prepareHoldBack(const Calibration& calibration);
     void measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings);
     void measureFingertips(const FramePair& pair, const PipelineSettings& settings);
 
@@ -167,6 +173,9 @@ private:
     std::optional<Calibration> correctedFrom_;
     cv::Mat rigPattern_;
     double displayPixelsPerMm_ = 1.0;
+    // The misregistration beyond which the table can no longer be told from a hand, projector pixels:
+    // what the segmentation's least elevation moves the code by, where it moves least over the display.
+    double heldBackBeyondPx_ = 0.0;
     HeightEvidence frameEvidence_;
     // Fixed capacity (the most fingertips), so that remembering allocates nothing; counts say what is used.
     std::vector<Remembered> remembered_;

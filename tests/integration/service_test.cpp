@@ -390,6 +390,10 @@ TEST_F(ServiceTest, WithTheCorrectionSwitchedOffAKnockedCameraIsShownAndLeftAsIt
     EXPECT_EQ(test::fileContents(dir_ / "calibration.yml"), saved);
     EXPECT_FALSE(std::filesystem::exists(dir_ / "calibration.yml.bak"));
     EXPECT_THAT(daemon_->output(), Not(HasSubstr("calibration corrected")));
+    // A code this far off leaves no table the segmentation can tell from a hand: no touch is reported, and
+    // State says why.
+    EXPECT_TRUE(waitForProperty("State", "s \"degraded\""));
+    EXPECT_THAT(get("StateReason"), HasSubstr("no touch is reported"));
 }
 
 TEST_F(ServiceTest, IntrospectionNamesArgumentsAndWhichPropertiesSignal) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 #include <set>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -164,23 +165,37 @@ TEST(TouchPipelineRendered, AFingerRestingOnTheTableIsNotLostToOnePairsSegmentat
     EXPECT_TRUE(touched);
 }
 
-// grid35 from 1.75 s on, a hand over the table, the camera knocked (0.5 degrees, 2 mm) at 2 s: the pipeline's
-// check of the calibration reads a fraction of a pixel before and the knock's misregistration within half a
-// second after it. With the correction, the pipeline then works with the camera's new pose and the check
-// reads a fraction of a pixel again; without it, the misregistration stays.
 struct KnockOutcome {
     std::optional<double> mostBeforePx;
     std::optional<double> seenAfterS;
     std::optional<double> correctedAfterS;
     std::optional<CalibrationCorrection> correction;
-    std::optional<double> lastPx;  // the check's reading at the end, 0.6 s after the knock
+    std::optional<double> lastPx;  // the check's reading at the end
+    // Contacts that began touching after the knock, before the first pair whose touches were held back and
+    // from then on.
+    int touchDownsBeforeHold = 0;
+    int touchDownsOnceHeld = 0;
+    int pairsHeldBack = 0;
 };
 
-KnockOutcome knockAt2s(bool correct) {
+// By default grid35 from 1.75 s on, a hand over the table, the camera knocked (0.5 degrees, 2 mm) at 2 s: the
+// pipeline's check of the calibration reads a fraction of a pixel before and the knock's misregistration
+// within half a second after it. With the correction, the pipeline then works with the camera's new pose and
+// the check reads a fraction of a pixel again; without it, the misregistration stays.
+struct Knock {
+    double atS = 2.0;
+    double degrees = 0.5;
+    double mm = 2.0;
+    double fromS = 1.75;  // the pairs processed, session time
+    double untilS = 2.6;
+};
+
+KnockOutcome knocked(const Knock& knock, bool correct) {
     sim::SimParameters parameters;
     parameters.scenario = "grid35";
-    constexpr double kKnockS = 2.0;
-    parameters.knockS = kKnockS;
+    parameters.knockS = knock.atS;
+    parameters.knockDeg = knock.degrees;
+    parameters.knockMm = knock.mm;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
     DetectionOptions options;
     options.correctCalibration = correct;
@@ -191,32 +206,43 @@ KnockOutcome knockAt2s(bool correct) {
     const auto frameAt = [&](double seconds) {
         return static_cast<std::uint64_t>(std::llround(seconds * parameters.frameRate));
     };
-    constexpr double kStartS = 1.75;
-    simulator.render(frameAt(kStartS), older, truth);
+    simulator.render(frameAt(knock.fromS), older, truth);
     KnockOutcome outcome;
-    for (std::uint64_t index = frameAt(kStartS) + 1; index < frameAt(kKnockS + 0.6); ++index) {
+    std::vector<std::uint32_t> touchingIds;
+    for (std::uint64_t index = frameAt(knock.fromS) + 1; index < frameAt(knock.untilS); ++index) {
         simulator.render(index, newer, truth);
         const PipelineResult& result = processInOrder(pipeline, older, newer, settings);
         std::swap(older, newer);
         const double seconds = simulator.frameSeconds(index);
+        std::vector<std::uint32_t> touching;
+        for (const Contact& contact : result.contacts)
+            if (contact.touching) {
+                touching.push_back(contact.id);
+                const bool began =
+                    std::find(touchingIds.begin(), touchingIds.end(), contact.id) == touchingIds.end();
+                if (began && seconds >= knock.atS)
+                    ++(outcome.pairsHeldBack > 0 ? outcome.touchDownsOnceHeld : outcome.touchDownsBeforeHold);
+            }
+        touchingIds = touching;
+        outcome.pairsHeldBack += result.heldBack ? 1 : 0;
         if (result.correction) {
             EXPECT_FALSE(outcome.correction) << "corrected twice";
             outcome.correction = result.correction;
-            outcome.correctedAfterS = seconds - kKnockS;
+            outcome.correctedAfterS = seconds - knock.atS;
         }
         outcome.lastPx = result.calibrationErrorPx;
         if (!result.calibrationErrorPx)
             continue;
-        if (seconds < kKnockS)
+        if (seconds < knock.atS)
             outcome.mostBeforePx = std::max(outcome.mostBeforePx.value_or(0.0), *result.calibrationErrorPx);
         else if (!outcome.seenAfterS && *result.calibrationErrorPx > 1.0)
-            outcome.seenAfterS = seconds - kKnockS;
+            outcome.seenAfterS = seconds - knock.atS;
     }
     return outcome;
 }
 
 TEST(TouchPipelineRendered, AKnockedCameraIsSeenWithinHalfASecondAndCorrected) {
-    const KnockOutcome outcome = knockAt2s(true);
+    const KnockOutcome outcome = knocked(Knock{}, true);
     ASSERT_TRUE(outcome.mostBeforePx) << "nothing was measured before the knock";
     RecordProperty("most_before_px", std::to_string(*outcome.mostBeforePx));
     EXPECT_LT(*outcome.mostBeforePx, 0.2);
@@ -235,11 +261,27 @@ TEST(TouchPipelineRendered, AKnockedCameraIsSeenWithinHalfASecondAndCorrected) {
 }
 
 TEST(TouchPipelineRendered, WithoutTheCorrectionAKnockedCameraStaysMisregistered) {
-    const KnockOutcome outcome = knockAt2s(false);
+    const KnockOutcome outcome = knocked(Knock{}, false);
     EXPECT_TRUE(outcome.seenAfterS);
     EXPECT_FALSE(outcome.correction);
     ASSERT_TRUE(outcome.lastPx);
     EXPECT_GT(*outcome.lastPx, 1.0);
+}
+
+TEST(TouchPipelineRendered, AKnockedCamerasTableIsNotTakenForFingersBeforeTheCorrection) {
+    // Knocked by 0.25 degrees at 1 s, while the hand is on its way to the first tap (1.7 s): the table's code
+    // lies up to 1 projector px off until the correction, and what the segmentation then takes for a hand is
+    // the table. Without the hold, 15 false touch-downs between the check's seeing the knock (half a round
+    // of tiles after it) and the correction; the 2 in the pairs before it sees it are not prevented.
+    const KnockOutcome outcome = knocked(Knock{1.0, 0.25, 0.5, 0.75, 1.6}, true);
+    ASSERT_TRUE(outcome.correction) << "the knock was not corrected within 0.6 s";
+    RecordProperty("corrected_after_s", std::to_string(*outcome.correctedAfterS));
+    RecordProperty("pairs_held_back", outcome.pairsHeldBack);
+    RecordProperty("touch_downs_before_hold", outcome.touchDownsBeforeHold);
+    EXPECT_GT(outcome.pairsHeldBack, 0);
+    EXPECT_EQ(outcome.touchDownsOnceHeld, 0);
+    ASSERT_TRUE(outcome.lastPx);
+    EXPECT_LT(*outcome.lastPx, 0.2);
 }
 
 TEST(TouchPipelineRendered, FramesOfAnotherSizeReleaseEveryContactAndSayWhy) {
