@@ -108,10 +108,11 @@ sanitize)
         'TouchPipelineRendered\.OnlyAStillSceneKeepsItsMask'
         'TouchPipelineRendered\.AFingerRestingOnTheTableIsNotLostToOnePairsSegmentation'
         # The calibration's check and correction: the knock left uncorrected (the same frames and code as the
-        # corrected knock's case), the pipeline's correction (the daemon's knocked camera runs it, through the
-        # daemon), and the readings of a calibration that holds, measured in the normal build (7-15 s each).
+        # corrected knock's case), the pipeline's correction and its hold on touches (the daemon's knocked
+        # camera runs both, through the daemon), and the readings of a calibration that holds, measured in the normal build (7-15 s each).
         'TouchPipelineRendered\.WithoutTheCorrectionAKnockedCameraStaysMisregistered'
         'TouchPipelineRendered\.AKnockedCameraIsSeenWithinHalfASecondAndCorrected'
+        'TouchPipelineRendered\.AKnockedCamerasTableIsNotTakenForFingersBeforeTheCorrection'
         'RegistrationCheck\.ACalibrationThatHoldsShowsAFewHundredthsOfAPixel'
         'CalibrationCorrector\.LeavesACalibrationThatHoldsAsItIs'
         # The check passing over the hand's tiles, the corrector's refusal and watch, the relocation's refusal
