@@ -264,8 +264,8 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
                 corrector_.update(registration_.measured(), registration_.latest()))
             adoptCorrection(*correction, settings);
     measureFingertips(ordered, settings);
-    // Beyond that misregistration the segmentation's height test takes the table itself for something above
-    // it, and what it then finds on the table are no fingers (a camera knocked by 0.25 degrees over grid35:
+    // Beyond heldBackBeyondPx_ the segmentation's height test takes the table itself for something above it,
+    // and what it then finds on the table are no fingers (a camera knocked by 0.25 degrees over grid35:
     // 37 false touch-downs in the 0.3 s before the correction). Every contact is released until the
     // correction, or a calibration, brings the code back.
     result_.heldBack = result_.calibrationErrorPx && *result_.calibrationErrorPx > heldBackBeyondPx_;

@@ -394,8 +394,7 @@ std::string Daemon::stateReason() const {
                 !problem.empty() && !loop_->idle() && !loop_->failing())
                 return "the calibration no longer fits: " + problem +
                        "; until it is corrected or \"everytouch-calib calibrate table\" runs, touches may "
-                       "land "
-                       "beside the fingers or be held back";
+                       "land beside the fingers or be held back";
             return "not detecting (" + (loop_ ? loop_->idleReason() : std::string("no frames yet")) + ")";
         case DaemonState::Failed:
             return loop_ ? loop_->failure().value_or("") : std::string();
