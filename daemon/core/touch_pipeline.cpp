@@ -35,6 +35,12 @@ constexpr double kSameWidths = 0.5;
 constexpr std::int64_t kMostStillUs = 100'000;
 // A pair whose S shows no code for the blur to be measured on is followed by this many without a try.
 constexpr int kPairsBetweenBlurMeasurements = 30;
+// Tiles running, the latest the check measured, that all lie beyond the hold's misregistration hold touches
+// back before the check's median moves (half a round of tiles after a knock), and as many running within it
+// let them go again: one tile's peak of chance is rare, the same shift in three places of the table running
+// is the code that moved. A knock that turns the camera shifts the code by different amounts across the
+// table, so single tiles within the limit come and go while it holds.
+constexpr std::size_t kTilesRunning = 3;
 constexpr std::string_view kHeldBackProblem =
     "the code lies further from where the calibration puts it than the table can be told from a hand at, and "
     "no touch is reported";
@@ -140,6 +146,21 @@ void TouchPipeline::prepareHoldBack(const Calibration& calibration) {
                 leastPxPerMm, (applyHomography(raised, pixel) - applyHomography(onTable, pixel)).norm());
         }
     heldBackBeyondPx_ = options_.segmentation.minElevationMm * leastPxPerMm;
+}
+
+bool TouchPipeline::holdTouches() {
+    const std::vector<TileShift>& latest = registration_.latest();
+    const auto running = [&](auto&& test) {
+        return latest.size() >= kTilesRunning &&
+               std::all_of(latest.end() - static_cast<std::ptrdiff_t>(kTilesRunning), latest.end(), test);
+    };
+    const double limitPx = heldBackBeyondPx_;
+    if (running([limitPx](const TileShift& tile) { return tile.projectorPx.norm() > limitPx; }))
+        holding_ = true;
+    else if (latest.size() < kTilesRunning ||
+             running([limitPx](const TileShift& tile) { return tile.projectorPx.norm() <= limitPx; }))
+        holding_ = false;
+    return holding_ || (result_.calibrationErrorPx && *result_.calibrationErrorPx > limitPx);
 }
 
 void TouchPipeline::prepareFingertips(const Calibration& calibration) {
@@ -268,7 +289,7 @@ const PipelineResult& TouchPipeline::process(const FramePair& pair, const Pipeli
     // and what it then finds on the table are no fingers (a camera knocked by 0.25 degrees over grid35:
     // 37 false touch-downs in the 0.3 s before the correction). Every contact is released until the
     // correction, or a calibration, brings the code back.
-    result_.heldBack = result_.calibrationErrorPx && *result_.calibrationErrorPx > heldBackBeyondPx_;
+    result_.heldBack = holdTouches();
     std::string_view problem = corrector_.problem();
     if (problem.empty() && result_.heldBack)
         problem = kHeldBackProblem;

@@ -148,6 +148,9 @@ private:
     void prepareFingertips(const Calibration& calibration);
     // heldBackBeyondPx_ for this calibration (after the segmenter's).
     void prepareHoldBack(const Calibration& calibration);
+    // Whether touches are held back in this pair: the check's median reading beyond heldBackBeyondPx_, or
+    // its latest tiles, three running, beyond it since they were last all within it.
+    bool holdTouches();
     void measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings);
     void measureFingertips(const FramePair& pair, const PipelineSettings& settings);
 
@@ -177,6 +180,7 @@ private:
     // The misregistration beyond which the table can no longer be told from a hand, projector pixels:
     // what the segmentation's least elevation moves the code by, where it moves least over the display.
     double heldBackBeyondPx_ = 0.0;
+    bool holding_ = false;  // by the latest tiles (holdTouches)
     HeightEvidence frameEvidence_;
     // Fixed capacity (the most fingertips), so that remembering allocates nothing; counts say what is used.
     std::vector<Remembered> remembered_;

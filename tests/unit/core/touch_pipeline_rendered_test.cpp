@@ -271,8 +271,8 @@ TEST(TouchPipelineRendered, WithoutTheCorrectionAKnockedCameraStaysMisregistered
 TEST(TouchPipelineRendered, AKnockedCamerasTableIsNotTakenForFingersBeforeTheCorrection) {
     // Knocked by 0.25 degrees at 1 s, while the hand is on its way to the first tap (1.7 s): the table's code
     // lies up to 1 projector px off until the correction, and what the segmentation then takes for a hand is
-    // the table. Without the hold, 15 false touch-downs between the check's seeing the knock (half a round
-    // of tiles after it) and the correction; the 2 in the pairs before it sees it are not prevented.
+    // the table. Without the hold, 15 false touch-downs between the check's seeing the knock and the
+    // correction; the 2 in the first two pairs, before three tiles were measured, are not prevented.
     const KnockOutcome outcome = knocked(Knock{1.0, 0.25, 0.5, 0.75, 1.6}, true);
     ASSERT_TRUE(outcome.correction) << "the knock was not corrected within 0.6 s";
     RecordProperty("corrected_after_s", std::to_string(*outcome.correctedAfterS));
