@@ -172,13 +172,18 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMove() {
         if (term.inlier)
             left += term.residualPx * term.residualPx;
     }
-    const double n = static_cast<double>(used);
+    return summarise(squares, left, used, 6);
+}
+
+CalibrationCorrector::Fit CalibrationCorrector::summarise(double squares, double left, int tiles,
+                                                          int parameters) {
+    const double n = static_cast<double>(tiles);
     Fit fit;
     fit.beforePx = std::sqrt(squares / n);
     fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
-    fit.noisePx = std::sqrt(left / (n - 3.0));
-    fit.residualSquares = left;
-    fit.tiles = used;
+    fit.leftPx = std::sqrt(left / n);
+    // Two equations a tile.
+    fit.noisePx = std::sqrt(left / (n - 0.5 * parameters));
     return fit;
 }
 
@@ -200,14 +205,7 @@ CalibrationCorrector::Fit CalibrationCorrector::fitImageShift(Eigen::Vector2d& s
     for (const TileTerm& term : terms_)
         if (term.inlier)
             left += (term.shift - term.imageOnPanel * shiftPx).squaredNorm();
-    const double n = static_cast<double>(used);
-    Fit fit;
-    fit.beforePx = std::sqrt(squares / n);
-    fit.explainedPx = std::sqrt(std::max(0.0, squares - left) / n);
-    fit.noisePx = std::sqrt(left / (n - 1.0));
-    fit.residualSquares = left;
-    fit.tiles = used;
-    return fit;
+    return summarise(squares, left, used, 2);
 }
 
 CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vector<TileShift>& tiles) {
@@ -277,7 +275,7 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
         std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0));
     // The simplest explanation that suffices: a creep corrected as many small moves of the camera adds up to
     // a pose that no longer fits, while a knock leaves far more than allowedPx after any shift of the image.
-    const bool imageCrept = std::sqrt(image.residualSquares / image.tiles) <= allowedPx;
+    const bool imageCrept = image.leftPx <= allowedPx;
     const Fit& fit = imageCrept ? image : move;
     const double notableNoisePx = options_.noiseMultiple * fit.noisePx;
     if (fit.beforePx < allowedPx) {

@@ -75,11 +75,10 @@ public:
 
 private:
     struct Fit {
-        double beforePx = 0.0;         // RMS shift over the tiles, projector pixels
-        double explainedPx = 0.0;      // RMS of the part the explanation accounts for
-        double noisePx = 0.0;          // RMS per tile of the rest, corrected for the parameters fitted
-        double residualSquares = 0.0;  // the rest's sum of squares, projector pixels squared
-        int tiles = 0;                 // inlier tiles fitted
+        double beforePx = 0.0;     // RMS shift over the tiles, projector pixels
+        double explainedPx = 0.0;  // RMS of the part the explanation accounts for
+        double leftPx = 0.0;       // RMS per tile of the rest: what the explanation leaves
+        double noisePx = 0.0;      // the same, corrected for the parameters fitted
     };
     // What the check measured at one tile, in the terms of a camera pose: the table point the projector
     // lights through the code predicted at the tile's centre, where the camera now sees it, and how camera
@@ -103,6 +102,9 @@ private:
         double residualPx = 0.0;  // what the last fit left of the shift
     };
     void prepareTerms(const std::vector<TileShift>& tiles);
+    // A fit over `tiles` tiles whose shifts' squares sum to `squares` before and `left` after fitting
+    // `parameters` parameters.
+    static Fit summarise(double squares, double left, int tiles, int parameters);
     Fit fitMove();  // over the inlier terms
     Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
     // The shift of the projector's image on its panel that fits the inlier terms best.
