@@ -63,6 +63,10 @@ float featureDistanceSquared(const float* a, const float* b) {
     return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
+float chromaticityDistanceSquared(const float* a, const float* b) {
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]);
+}
+
 // Blocks searched for colour samples around a block on the outline.
 constexpr int kColourReach = 3;
 constexpr int kColourSamples = (2 * kColourReach + 1) * (2 * kColourReach + 1);
@@ -101,6 +105,22 @@ public:
             second_[k] = second_[count_ - 1];
             third_[k] = third_[count_ - 1];
         }
+    }
+    // The squared distance in chromaticity alone (the first two components).
+    float nearestChromaticityDistance(const float* feature) const {
+        const Query query(feature);
+        constexpr float kFar = std::numeric_limits<float>::max();
+        Lanes nearest = {kFar, kFar, kFar, kFar};
+        for (int k = 0; k < count_; k += kLanes) {
+            Lanes da, db;
+            std::memcpy(&da, first_ + k, sizeof da);
+            std::memcpy(&db, second_ + k, sizeof db);
+            da -= query.first;
+            db -= query.second;
+            const Lanes distance = da * da + db * db;
+            nearest = distance < nearest ? distance : nearest;
+        }
+        return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
     }
     float nearestDistance(const float* feature) const {
         const Query query(feature);
@@ -168,6 +188,21 @@ constexpr float kSignificance = 3.0f;
 // The brightest code pixel shows twice the code's mean (half the bits are 1); noise and a brighter patch of
 // table add to that. Beyond this many times the table's mean, S is no longer code.
 constexpr float kMotionAmplitudes = 3.0f;
+// The table's colour beyond the projection is measured on the pixels of this many of its blocks at most: 256
+// pixels set a median to a tenth of their scatter, and the scatter's median to a fifth of itself.
+constexpr std::size_t kMaxUnlitTableBlocks = 16;
+// An unlit pixel is the hand's when its chromaticity is at least three times nearer the skin's than the unlit
+// table's (squared distances nine times): a pixel on the outline that mixes the two is then three quarters
+// skin or more.
+constexpr float kUnlitSkinRatio = 9.0f;
+// S within this many standard deviations of its noise about the level where nothing is lit: the scene did
+// not change between the two frames.
+constexpr float kStillSigmas = 3.0f;
+// A pixel that gets no projector light is the hand only when its chromaticity lies farther from the table's
+// as the room alone lights it than all but one in a thousand of the table's own pixels would, were their
+// scatter Gaussian: the squared distance of two such components exceeds 13.82 times their variance one time
+// in a thousand, and its median is 1.386 times it.
+constexpr float kUnlitTableSpreadPerMedian = 13.82f / 1.386f;
 // A block that shows the table's code joins a touching finger only when its colour is at least three times
 // nearer the hand's than the table's (squared distances nine times): the code, the stronger cue, says table.
 constexpr float kTouchingColourRatio = 9.0f;
@@ -288,7 +323,10 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
                 unlitWindows_.push_back(by * blocks.width + bx);
     // The per-frame buffers at their largest, so that no frame allocates.
     const std::size_t blockCount = static_cast<std::size_t>(blocks.area());
-    values_.reserve(blockCount);
+    const std::size_t unlitPixels = static_cast<std::size_t>(kMaxUnlitTableBlocks * blockPx * blockPx);
+    values_.reserve(std::max(blockCount, unlitPixels));
+    for (auto& component : unlitFeatures_)
+        component.reserve(unlitPixels);
     unlitVariances_.reserve(blockCount);
     queue_.resize(blockCount);
     component_.resize(blockCount);
@@ -341,6 +379,7 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     blockColour_.create(blockClass_.size(), CV_32FC3);
     colourKnown_.create(blockClass_.size(), CV_8UC1);
     fill(colourKnown_, 0);
+    measureUnlitTable(texture);
     growIntoFaintBlocks(texture);
     growOverTouchingSkin(texture);
     findHandBox();
@@ -451,6 +490,7 @@ void HandSegmenter::classifyBlocks(int channels) {
     // A pixel gets no projector light at all (a shadow) when the mean of S around it stays within the noise
     // of the level where nothing is lit: three standard deviations of a 3 x 3 mean.
     litAmplitude_ = zeroLevel + std::sqrt(noiseVariance_);
+    zeroLevel_ = zeroLevel;
 }
 
 bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
@@ -612,6 +652,46 @@ float HandSegmenter::nearestTableColour(const cv::Mat& texture, int block, int r
             if (isSample(ty * cols + tx))
                 nearest = std::min(nearest, featureDistanceSquared(colour, blockFeature(texture, ty, tx)));
     return nearest;
+}
+
+void HandSegmenter::measureUnlitTable(const cv::Mat& texture) {
+    unlitTableKnown_ = false;
+    // A gray camera sees no chromaticity, and the brightness of what the room alone lights says nothing.
+    if (unlitWindows_.size() < kMinUnlitWindows || texture.channels() != 3)
+        return;
+    // The pixels of up to kMaxUnlitTableBlocks blocks beyond the projection, spread over them.
+    const std::size_t stride = (unlitWindows_.size() + kMaxUnlitTableBlocks - 1) / kMaxUnlitTableBlocks;
+    const int blockPx = options_.blockPx, cols = blockClass_.cols, channels = texture.channels();
+    for (auto& component : unlitFeatures_)
+        component.clear();
+    for (std::size_t k = 0; k < unlitWindows_.size(); k += stride) {
+        const int by = unlitWindows_[k] / cols, bx = unlitWindows_[k] % cols;
+        for (int y = by * blockPx; y < (by + 1) * blockPx; ++y) {
+            const uchar* row = texture.ptr<uchar>(y);
+            for (int x = bx * blockPx; x < (bx + 1) * blockPx; ++x) {
+                float colour[3], feature[3];
+                for (int ch = 0; ch < channels; ++ch)
+                    colour[ch] = row[x * channels + ch];
+                colourFeature(colour, channels, feature);
+                for (int i = 0; i < 3; ++i)
+                    unlitFeatures_[i].push_back(feature[i]);
+            }
+        }
+    }
+    float median[3];
+    for (int i = 0; i < 3; ++i)
+        median[i] = quantile(unlitFeatures_[i], 0.5);
+    // The spread of single pixels about it: the table's own variation and the camera's noise, which at low
+    // light scatters the chromaticity widely. From the median distance, since an arm reaching in from
+    // beyond the table's edge covers some of these pixels.
+    values_.clear();
+    for (std::size_t k = 0; k < unlitFeatures_[0].size(); ++k) {
+        const float feature[3] = {unlitFeatures_[0][k], unlitFeatures_[1][k], unlitFeatures_[2][k]};
+        values_.push_back(chromaticityDistanceSquared(feature, median));
+    }
+    unlitTableSpread_ = kUnlitTableSpreadPerMedian * quantile(values_, 0.5);
+    std::copy(median, median + 3, unlitTableColour_);
+    unlitTableKnown_ = true;
 }
 
 void HandSegmenter::growIntoFaintBlocks(const cv::Mat& texture) {
@@ -874,18 +954,38 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     int localSum = 0;
                     for (int dx = 0; dx <= 2 * kLitReach; ++dx)
                         localSum += columnSums[px + dx];
-                    if (c != Grown && localSum < litSum) {
-                        out[x] = 0;
+                    const bool lit = c == Grown || localSum >= litSum;
+                    if (lit && inside) {
+                        out[x] = 255;
                         continue;
                     }
-                    if (inside) {
-                        out[x] = 255;
+                    if (!lit && !unlitTableKnown_) {
+                        out[x] = 0;
                         continue;
                     }
                     float colour[3], pixel[3];
                     for (int ch = 0; ch < channels; ++ch)
                         colour[ch] = row[x * channels + ch];
                     colourFeature(colour, channels, pixel);
+                    if (!lit) {
+                        // No projector light: the table in the hand's shadow, or the hand over black content.
+                        // Both are lit by the room alone, as the table beyond the projection is.
+                        const float unlitTableDistance =
+                            chromaticityDistanceSquared(pixel, unlitTableColour_);
+                        bool isHandPixel =
+                            unlitTableDistance > unlitTableSpread_ && stillAt(subtraction, x, y);
+                        if (isHandPixel) {
+                            // The skin's chromaticity: its own block's deep inside, the nearest clean
+                            // sample's on the outline.
+                            const float handDistance =
+                                inside ? chromaticityDistanceSquared(pixel, blockFeature(texture, by, bx))
+                                       : handSide.nearestChromaticityDistance(pixel);
+                            isHandPixel = kUnlitSkinRatio * handDistance < unlitTableDistance;
+                        }
+                        out[x] = isHandPixel ? 255 : 0;
+                        lastWasHand = isHandPixel;
+                        continue;
+                    }
                     bool isHandPixel;
                     if (lastWasHand) {
                         isHandPixel = handSide.anyWithin(pixel, other.nearestDistance(pixel), true);
@@ -899,6 +999,19 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                 }
             }
         }
+}
+
+bool HandSegmenter::stillAt(const cv::Mat& subtraction, int x, int y) const {
+    // Within three standard deviations of the noise about the level where nothing is lit, over 3 x 3
+    // pixels: beyond it the scene changed between the two frames there.
+    const float limit = kStillSigmas * std::sqrt(noiseVariance_);
+    for (int py = std::max(y - 1, 0); py <= std::min(y + 1, subtraction.rows - 1); ++py) {
+        const short* s = subtraction.ptr<short>(py);
+        for (int px = std::max(x - 1, 0); px <= std::min(x + 1, subtraction.cols - 1); ++px)
+            if (std::abs(s[px] - zeroLevel_) > limit)
+                return false;
+    }
+    return true;
 }
 
 void HandSegmenter::segmentAsPaper(const cv::Mat& texture, cv::Mat& mask) {

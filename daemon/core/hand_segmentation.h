@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -125,6 +126,11 @@ private:
     // which the step clears), since a block beside several hand blocks is judged from each.
     template <typename IsSample>
     float nearestTableColour(const cv::Mat& texture, int block, int reach, IsSample isSample);
+    // unlitTableColour_ and unlitTableSpread_ receive the table's colour where only the room lights it, from
+    // the view beyond the projection (unlitTableKnown_: there is one).
+    void measureUnlitTable(const cv::Mat& texture);
+    // Whether S around the pixel holds nothing but noise about the level where nothing is lit.
+    bool stillAt(const cv::Mat& subtraction, int x, int y) const;
     void growIntoFaintBlocks(const cv::Mat& texture);
     void growOverTouchingSkin(const cv::Mat& texture);
     // handBox_ receives the box of the hand's blocks (empty without any).
@@ -142,6 +148,7 @@ private:
     cv::Mat judgedRegion_;
     double pixelsPerMm_ = 1.0;
     float litAmplitude_ = 0.0f;
+    float zeroLevel_ = 0.0f;       // S where nothing is lit (DN)
     float tableAmplitude_ = 0.0f;  // mean S on the table in the last frame
     float noiseVariance_ = 0.0f;   // of S where only noise is seen (DN^2)
 
@@ -155,7 +162,11 @@ private:
     std::vector<int> litPatch_;    // S around one block, as labelPixels' lit test counts it
     std::vector<int> litColumns_;  // one row of litPatch_'s sums over the lit test's height
     std::vector<float> values_;
-    std::vector<float> unlitVariances_;  // of S in each window of unlitWindows_
+    std::vector<float> unlitVariances_;                // of S in each window of unlitWindows_
+    std::array<std::vector<float>, 3> unlitFeatures_;  // colour features of pixels beyond the projection
+    bool unlitTableKnown_ = false;
+    float unlitTableColour_[3] = {};  // colour feature: the median of the pixels beyond the projection
+    float unlitTableSpread_ = 0.0f;   // squared chromaticity distance from it that holds nearly all of them
     std::vector<int> queue_;
     std::vector<int> component_;
     std::vector<cv::Point> sampleBlocks_;  // the blocks of a component its tests read, top-left pixels

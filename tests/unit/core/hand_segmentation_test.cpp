@@ -15,8 +15,8 @@ namespace everytouch::core {
 namespace {
 
 struct DiskScore {
-    int truth = 0, found = 0;  // hand pixels of the truth near the pads, and how many the mask has
-    int marked = 0;            // pixels the mask has near the pads
+    long truth = 0, found = 0;  // hand pixels of the truth (near the pads), and how many the mask has
+    long marked = 0;            // pixels the mask has (near the pads)
     double recall() const { return truth ? static_cast<double>(found) / truth : 0.0; }
     double precision() const { return marked ? static_cast<double>(found) / marked : 0.0; }
 };
@@ -87,6 +87,26 @@ DiskScore scoreTouchingEnds(const std::string& scenario, const SegmentationOptio
                     addDisk(truth.handMask, mask,
                             projectPoint(calibration.cameraMatrix, calibration.tableToCamera, finger.pad),
                             radiusPx, score);
+        });
+    return score;
+}
+
+// The hand's pixels where the segmentation decides (the display less a window's half at its edge), over
+// `samples` pairs spread across the scenario's cycle.
+DiskScore scoreJudgedRegion(const sim::SimParameters& parameters, int samples) {
+    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
+    HandSegmenter segmenter(SegmentationOptions{});
+    segmenter.setRig(simulator.calibration(), simulator.pattern());
+    DiskScore score;
+    cv::Mat judgedTruth, found;
+    segmentSampledPairs(
+        simulator, segmenter, samples, [](const sim::FrameTruth&) { return true; },
+        [&](const sim::FrameTruth& truth, const cv::Mat& mask) {
+            cv::bitwise_and(truth.handMask, segmenter.judgedRegion(), judgedTruth);
+            cv::bitwise_and(judgedTruth, mask, found);
+            score.truth += cv::countNonZero(judgedTruth);
+            score.marked += cv::countNonZero(mask);
+            score.found += cv::countNonZero(found);
         });
     return score;
 }
@@ -175,27 +195,24 @@ TEST(HandSegmentation, ACameraFramedOnTheProjectionStillTellsTheTableFromTheHand
     sim::SimParameters parameters;
     parameters.scenario = "grid35";
     parameters.cameraFocalMm = 9.0;  // the display fills the frame and reaches beyond it
-    sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    HandSegmenter segmenter(SegmentationOptions{});
-    segmenter.setRig(simulator.calibration(), simulator.pattern());
+    const DiskScore score = scoreJudgedRegion(parameters, 60);
+    ASSERT_GT(score.truth, 100000) << "the test needs a hand in view";
+    EXPECT_GE(score.precision(), 0.92) << score.found << " of " << score.marked << " pixels marked";
+    EXPECT_GE(score.recall(), 0.8) << score.found << " of " << score.truth << " hand pixels";
+}
 
-    // Scored where the segmentation decides (the display less a window's half at its edge).
-    long truthPixels = 0, markedPixels = 0, foundPixels = 0;
-    cv::Mat judgedTruth, found;
-    segmentSampledPairs(
-        simulator, segmenter, 60, [](const sim::FrameTruth&) { return true; },
-        [&](const sim::FrameTruth& truth, const cv::Mat& mask) {
-            cv::bitwise_and(truth.handMask, segmenter.judgedRegion(), judgedTruth);
-            cv::bitwise_and(judgedTruth, mask, found);
-            truthPixels += cv::countNonZero(judgedTruth);
-            markedPixels += cv::countNonZero(mask);
-            foundPixels += cv::countNonZero(found);
-        });
-    ASSERT_GT(truthPixels, 100000) << "the test needs a hand in view";
-    const double precision = static_cast<double>(foundPixels) / static_cast<double>(markedPixels);
-    const double recall = static_cast<double>(foundPixels) / static_cast<double>(truthPixels);
-    EXPECT_GE(precision, 0.92) << foundPixels << " of " << markedPixels << " pixels marked";
-    EXPECT_GE(recall, 0.8) << foundPixels << " of " << truthPixels << " hand pixels";
+TEST(HandSegmentation, AHandOverDarkContentIsToldFromItsShadowByTheRoomsLight) {
+    // Where the content is near black, the projector lights neither the table nor the hand, and the code
+    // shows nothing of either. The table in the hand's shadow looks like the table beyond the projection,
+    // which the room alone lights too; the hand over the dark content does not. Without projector light
+    // every pixel was taken for shadow: a recall of 0.72 here then (precision 0.89), 0.89 as measured
+    // (precision 0.87).
+    sim::SimParameters parameters;
+    parameters.scenario = "multitouch";
+    const DiskScore score = scoreJudgedRegion(parameters, 60);
+    ASSERT_GT(score.truth, 100000) << "the test needs a hand in view";
+    EXPECT_GE(score.recall(), 0.8) << score.found << " of " << score.truth << " hand pixels";
+    EXPECT_GE(score.precision(), 0.83) << score.found << " of " << score.marked << " pixels marked";
 }
 
 // The fraction of the judged region a segmenter marks as hand on an empty table, in the median of pairs
