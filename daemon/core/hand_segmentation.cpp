@@ -106,22 +106,6 @@ public:
             third_[k] = third_[count_ - 1];
         }
     }
-    // The squared distance in chromaticity alone (the first two components).
-    float nearestChromaticityDistance(const float* feature) const {
-        const Query query(feature);
-        constexpr float kFar = std::numeric_limits<float>::max();
-        Lanes nearest = {kFar, kFar, kFar, kFar};
-        for (int k = 0; k < count_; k += kLanes) {
-            Lanes da, db;
-            std::memcpy(&da, first_ + k, sizeof da);
-            std::memcpy(&db, second_ + k, sizeof db);
-            da -= query.first;
-            db -= query.second;
-            const Lanes distance = da * da + db * db;
-            nearest = distance < nearest ? distance : nearest;
-        }
-        return std::min(std::min(nearest[0], nearest[1]), std::min(nearest[2], nearest[3]));
-    }
     float nearestDistance(const float* feature) const {
         const Query query(feature);
         constexpr float kFar = std::numeric_limits<float>::max();
@@ -192,8 +176,7 @@ constexpr float kMotionAmplitudes = 3.0f;
 // pixels set a median to a tenth of their scatter, and the scatter's median to a fifth of itself.
 constexpr std::size_t kMaxUnlitTableBlocks = 16;
 // An unlit pixel is the hand's when its chromaticity is at least three times nearer the skin's than the unlit
-// table's (squared distances nine times): a pixel on the outline that mixes the two is then three quarters
-// skin or more.
+// table's (squared distances nine times): a pixel that mixes the two is then three quarters skin or more.
 constexpr float kUnlitSkinRatio = 9.0f;
 // S within this many standard deviations of its noise about the level where nothing is lit: the scene did
 // not change between the two frames.
@@ -955,11 +938,11 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     for (int dx = 0; dx <= 2 * kLitReach; ++dx)
                         localSum += columnSums[px + dx];
                     const bool lit = c == Grown || localSum >= litSum;
-                    if (lit && inside) {
-                        out[x] = 255;
+                    if (inside) {
+                        out[x] = lit || unlitHandAt(texture, subtraction, x, y, by, bx) ? 255 : 0;
                         continue;
                     }
-                    if (!lit && !unlitTableKnown_) {
+                    if (!lit) {
                         out[x] = 0;
                         continue;
                     }
@@ -967,25 +950,6 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     for (int ch = 0; ch < channels; ++ch)
                         colour[ch] = row[x * channels + ch];
                     colourFeature(colour, channels, pixel);
-                    if (!lit) {
-                        // No projector light: the table in the hand's shadow, or the hand over black content.
-                        // Both are lit by the room alone, as the table beyond the projection is.
-                        const float unlitTableDistance =
-                            chromaticityDistanceSquared(pixel, unlitTableColour_);
-                        bool isHandPixel =
-                            unlitTableDistance > unlitTableSpread_ && stillAt(subtraction, x, y);
-                        if (isHandPixel) {
-                            // The skin's chromaticity: its own block's deep inside, the nearest clean
-                            // sample's on the outline.
-                            const float handDistance =
-                                inside ? chromaticityDistanceSquared(pixel, blockFeature(texture, by, bx))
-                                       : handSide.nearestChromaticityDistance(pixel);
-                            isHandPixel = kUnlitSkinRatio * handDistance < unlitTableDistance;
-                        }
-                        out[x] = isHandPixel ? 255 : 0;
-                        lastWasHand = isHandPixel;
-                        continue;
-                    }
                     bool isHandPixel;
                     if (lastWasHand) {
                         isHandPixel = handSide.anyWithin(pixel, other.nearestDistance(pixel), true);
@@ -999,6 +963,24 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                 }
             }
         }
+}
+
+bool HandSegmenter::unlitHandAt(const cv::Mat& texture, const cv::Mat& subtraction, int x, int y, int by,
+                                int bx) {
+    // No projector light: the table in the hand's shadow, or the hand over black content. Both are lit by
+    // the room alone, as the table beyond the projection is, and the skin's chromaticity is its block's.
+    if (!unlitTableKnown_)
+        return false;
+    const int channels = texture.channels();
+    const uchar* value = texture.ptr<uchar>(y) + x * channels;
+    float colour[3], pixel[3];
+    for (int ch = 0; ch < channels; ++ch)
+        colour[ch] = value[ch];
+    colourFeature(colour, channels, pixel);
+    const float unlitTableDistance = chromaticityDistanceSquared(pixel, unlitTableColour_);
+    return unlitTableDistance > unlitTableSpread_ && stillAt(subtraction, x, y) &&
+           kUnlitSkinRatio * chromaticityDistanceSquared(pixel, blockFeature(texture, by, bx)) <
+               unlitTableDistance;
 }
 
 bool HandSegmenter::stillAt(const cv::Mat& subtraction, int x, int y) const {

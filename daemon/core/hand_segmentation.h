@@ -129,6 +129,9 @@ private:
     // unlitTableColour_ and unlitTableSpread_ receive the table's colour where only the room lights it, from
     // the view beyond the projection (unlitTableKnown_: there is one).
     void measureUnlitTable(const cv::Mat& texture);
+    // Whether the pixel (x, y) of block (bx, by) deep inside the hand, which gets no projector light, is
+    // the hand's by its colour in the room's light.
+    bool unlitHandAt(const cv::Mat& texture, const cv::Mat& subtraction, int x, int y, int by, int bx);
     // Whether S around the pixel holds nothing but noise about the level where nothing is lit.
     bool stillAt(const cv::Mat& subtraction, int x, int y) const;
     void growIntoFaintBlocks(const cv::Mat& texture);

@@ -205,14 +205,15 @@ TEST(HandSegmentation, AHandOverDarkContentIsToldFromItsShadowByTheRoomsLight) {
     // Where the content is near black, the projector lights neither the table nor the hand, and the code
     // shows nothing of either. The table in the hand's shadow looks like the table beyond the projection,
     // which the room alone lights too; the hand over the dark content does not. Without projector light
-    // every pixel was taken for shadow: a recall of 0.72 here then (precision 0.89), 0.89 as measured
-    // (precision 0.87).
+    // every pixel was taken for shadow: a recall of 0.72 here then (precision 0.89), 0.78 as measured
+    // (precision 0.88). Deep inside the hand only: on its outline as well it was 0.89 (0.87), but the
+    // fingers' silhouettes widened, which moved their heights (docs/detection.md, step 5).
     sim::SimParameters parameters;
     parameters.scenario = "multitouch";
     const DiskScore score = scoreJudgedRegion(parameters, 60);
     ASSERT_GT(score.truth, 100000) << "the test needs a hand in view";
-    EXPECT_GE(score.recall(), 0.8) << score.found << " of " << score.truth << " hand pixels";
-    EXPECT_GE(score.precision(), 0.83) << score.found << " of " << score.marked << " pixels marked";
+    EXPECT_GE(score.recall(), 0.76) << score.found << " of " << score.truth << " hand pixels";
+    EXPECT_GE(score.precision(), 0.86) << score.found << " of " << score.marked << " pixels marked";
 }
 
 // The fraction of the judged region a segmenter marks as hand on an empty table, in the median of pairs
