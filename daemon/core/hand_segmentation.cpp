@@ -59,12 +59,12 @@ void colourFeature(const float* bgr, int channels, float* feature) {
     feature[2] = kBrightnessWeight * sum / 3.0f;
 }
 
-float featureDistanceSquared(const float* a, const float* b) {
-    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
-}
-
 float chromaticityDistanceSquared(const float* a, const float* b) {
     return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]);
+}
+
+float featureDistanceSquared(const float* a, const float* b) {
+    return chromaticityDistanceSquared(a, b) + (a[2] - b[2]) * (a[2] - b[2]);
 }
 
 // Blocks searched for colour samples around a block on the outline.
@@ -308,7 +308,7 @@ void HandSegmenter::setRig(const Calibration& calibration, const cv::Mat& patter
     const std::size_t blockCount = static_cast<std::size_t>(blocks.area());
     const std::size_t unlitPixels = static_cast<std::size_t>(kMaxUnlitTableBlocks * blockPx * blockPx);
     values_.reserve(std::max(blockCount, unlitPixels));
-    for (auto& component : unlitFeatures_)
+    for (auto& component : unlitChromaticities_)
         component.reserve(unlitPixels);
     unlitVariances_.reserve(blockCount);
     queue_.resize(blockCount);
@@ -362,7 +362,7 @@ void HandSegmenter::segmentByCode(const cv::Mat& texture, const cv::Mat& subtrac
     blockColour_.create(blockClass_.size(), CV_32FC3);
     colourKnown_.create(blockClass_.size(), CV_8UC1);
     fill(colourKnown_, 0);
-    measureUnlitTable(texture);
+    unlitTableMeasured_ = false;
     growIntoFaintBlocks(texture);
     growOverTouchingSkin(texture);
     findHandBox();
@@ -638,6 +638,7 @@ float HandSegmenter::nearestTableColour(const cv::Mat& texture, int block, int r
 }
 
 void HandSegmenter::measureUnlitTable(const cv::Mat& texture) {
+    unlitTableMeasured_ = true;
     unlitTableKnown_ = false;
     // A gray camera sees no chromaticity, and the brightness of what the room alone lights says nothing.
     if (unlitWindows_.size() < kMinUnlitWindows || texture.channels() != 3)
@@ -645,7 +646,7 @@ void HandSegmenter::measureUnlitTable(const cv::Mat& texture) {
     // The pixels of up to kMaxUnlitTableBlocks blocks beyond the projection, spread over them.
     const std::size_t stride = (unlitWindows_.size() + kMaxUnlitTableBlocks - 1) / kMaxUnlitTableBlocks;
     const int blockPx = options_.blockPx, cols = blockClass_.cols, channels = texture.channels();
-    for (auto& component : unlitFeatures_)
+    for (auto& component : unlitChromaticities_)
         component.clear();
     for (std::size_t k = 0; k < unlitWindows_.size(); k += stride) {
         const int by = unlitWindows_[k] / cols, bx = unlitWindows_[k] % cols;
@@ -656,24 +657,22 @@ void HandSegmenter::measureUnlitTable(const cv::Mat& texture) {
                 for (int ch = 0; ch < channels; ++ch)
                     colour[ch] = row[x * channels + ch];
                 colourFeature(colour, channels, feature);
-                for (int i = 0; i < 3; ++i)
-                    unlitFeatures_[i].push_back(feature[i]);
+                for (std::size_t i = 0; i < unlitChromaticities_.size(); ++i)
+                    unlitChromaticities_[i].push_back(feature[i]);
             }
         }
     }
-    float median[3];
-    for (int i = 0; i < 3; ++i)
-        median[i] = quantile(unlitFeatures_[i], 0.5);
+    for (std::size_t i = 0; i < unlitChromaticities_.size(); ++i)
+        unlitTableChromaticity_[i] = quantile(unlitChromaticities_[i], 0.5);
     // The spread of single pixels about it: the table's own variation and the camera's noise, which at low
     // light scatters the chromaticity widely. From the median distance, since an arm reaching in from
     // beyond the table's edge covers some of these pixels.
     values_.clear();
-    for (std::size_t k = 0; k < unlitFeatures_[0].size(); ++k) {
-        const float feature[3] = {unlitFeatures_[0][k], unlitFeatures_[1][k], unlitFeatures_[2][k]};
-        values_.push_back(chromaticityDistanceSquared(feature, median));
+    for (std::size_t k = 0; k < unlitChromaticities_[0].size(); ++k) {
+        const float chromaticity[2] = {unlitChromaticities_[0][k], unlitChromaticities_[1][k]};
+        values_.push_back(chromaticityDistanceSquared(chromaticity, unlitTableChromaticity_));
     }
     unlitTableSpread_ = kUnlitTableSpreadPerMedian * quantile(values_, 0.5);
-    std::copy(median, median + 3, unlitTableColour_);
     unlitTableKnown_ = true;
 }
 
@@ -969,6 +968,8 @@ bool HandSegmenter::unlitHandAt(const cv::Mat& texture, const cv::Mat& subtracti
                                 int bx) {
     // No projector light: the table in the hand's shadow, or the hand over black content. Both are lit by
     // the room alone, as the table beyond the projection is, and the skin's chromaticity is its block's.
+    if (!unlitTableMeasured_)
+        measureUnlitTable(texture);
     if (!unlitTableKnown_)
         return false;
     const int channels = texture.channels();
@@ -977,7 +978,7 @@ bool HandSegmenter::unlitHandAt(const cv::Mat& texture, const cv::Mat& subtracti
     for (int ch = 0; ch < channels; ++ch)
         colour[ch] = value[ch];
     colourFeature(colour, channels, pixel);
-    const float unlitTableDistance = chromaticityDistanceSquared(pixel, unlitTableColour_);
+    const float unlitTableDistance = chromaticityDistanceSquared(pixel, unlitTableChromaticity_);
     return unlitTableDistance > unlitTableSpread_ && stillAt(subtraction, x, y) &&
            kUnlitSkinRatio * chromaticityDistanceSquared(pixel, blockFeature(texture, by, bx)) <
                unlitTableDistance;

@@ -126,8 +126,9 @@ private:
     // which the step clears), since a block beside several hand blocks is judged from each.
     template <typename IsSample>
     float nearestTableColour(const cv::Mat& texture, int block, int reach, IsSample isSample);
-    // unlitTableColour_ and unlitTableSpread_ receive the table's colour where only the room lights it, from
-    // the view beyond the projection (unlitTableKnown_: there is one).
+    // unlitTableChromaticity_ and unlitTableSpread_ receive the table's colour where only the room lights it,
+    // from the view beyond the projection (unlitTableKnown_: there is one). Measured once per frame, when the
+    // first unlit pixel deep inside a hand asks for it.
     void measureUnlitTable(const cv::Mat& texture);
     // Whether the pixel (x, y) of block (bx, by) deep inside the hand, which gets no projector light, is
     // the hand's by its colour in the room's light.
@@ -165,11 +166,12 @@ private:
     std::vector<int> litPatch_;    // S around one block, as labelPixels' lit test counts it
     std::vector<int> litColumns_;  // one row of litPatch_'s sums over the lit test's height
     std::vector<float> values_;
-    std::vector<float> unlitVariances_;                // of S in each window of unlitWindows_
-    std::array<std::vector<float>, 3> unlitFeatures_;  // colour features of pixels beyond the projection
+    std::vector<float> unlitVariances_;                      // of S in each window of unlitWindows_
+    std::array<std::vector<float>, 2> unlitChromaticities_;  // of pixels beyond the projection
+    bool unlitTableMeasured_ = false;                        // in this frame
     bool unlitTableKnown_ = false;
-    float unlitTableColour_[3] = {};  // colour feature: the median of the pixels beyond the projection
-    float unlitTableSpread_ = 0.0f;   // squared chromaticity distance from it that holds nearly all of them
+    float unlitTableChromaticity_[2] = {};  // the median of the pixels beyond the projection
+    float unlitTableSpread_ = 0.0f;         // squared chromaticity distance from it that holds nearly all
     std::vector<int> queue_;
     std::vector<int> component_;
     std::vector<cv::Point> sampleBlocks_;  // the blocks of a component its tests read, top-left pixels
