@@ -525,12 +525,20 @@ bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
             ++idealCount;
         }
     }
+    // Both searches below take the best of many tries (two dozen heights, two dozen shifts). Chance
+    // correlations over the region, at the best of so many, stay below this many of their standard
+    // deviations: neither a faint code over dark content nor the shading a moving hand leaves in S may
+    // pass for the table by chance. Without it, one pair in a few dozen of a hand moving above the table
+    // found a chance peak near the table's height, and the whole hand was lost for that pair.
+    constexpr double kSearchSignificance = 4.0;
+    const double chance = std::sqrt(2.0 / static_cast<double>(sampleBlocks_.size() * perBlock));
+    const double searchLimit = kSearchSignificance * chance;
     // Heights a few millimetres apart: the table and a hand lie ten or more apart.
     const std::size_t stride = std::max<std::size_t>(
         1, static_cast<std::size_t>(std::floor(0.5 * options_.minElevationMm / options_.elevation.stepMm)));
     elevation_.measurePixels(elevationEvidence_, stride);
     const HeightEstimate height = elevation_.estimate(elevationEvidence_);
-    if (height.valid && height.heightMm < options_.minElevationMm)
+    if (height.valid && height.heightMm < options_.minElevationMm && height.correlation >= searchLimit)
         return true;
     // A table the calibration puts a little off shows its code beside the predicted place: as a block, it
     // passes the table's test there (half the correlation the table reaches at that amplitude).
@@ -540,11 +548,7 @@ bool HandSegmenter::liesOnTable(const cv::Mat& subtraction, int size) {
     const CodeShiftMatch match =
         shiftedCode_.bestMatch(subtraction, sampleBlocks_, blockPx,
                                options_.misregistrationPx / tableCode_.projectorPixelsPerCameraPixel);
-    // Chance correlations over the region, at the best of the twenty-odd shifts tried, stay below this many
-    // of their standard deviations: a faint code over dark content must not pass for the table by chance.
-    constexpr double kSearchSignificance = 4.0;
-    const double chance = std::sqrt(2.0 / static_cast<double>(sampleBlocks_.size() * perBlock));
-    if (match.correlation < kSearchSignificance * chance)
+    if (match.correlation < searchLimit)
         return false;
     return match.correlation >= 0.5 * expected;
 }
