@@ -940,9 +940,15 @@ void HandSegmenter::labelPixels(const cv::Mat& texture, const cv::Mat& subtracti
                     int localSum = 0;
                     for (int dx = 0; dx <= 2 * kLitReach; ++dx)
                         localSum += columnSums[px + dx];
-                    const bool lit = c == Grown || localSum >= litSum;
+                    // A pixel without projector light is hand only by the room's light (below), whichever way
+                    // its block joined the hand: a faint block joined by its colour shows no code, and
+                    // neither does the shadow beside the hand within it.
+                    bool lit = localSum >= litSum;
+                    if (!lit && (inside || c == Grown))
+                        lit = (c == Grown && !roomLightKnown(texture)) ||
+                              unlitHandAt(texture, subtraction, x, y, by, bx);
                     if (inside) {
-                        out[x] = lit || unlitHandAt(texture, subtraction, x, y, by, bx) ? 255 : 0;
+                        out[x] = lit ? 255 : 0;
                         continue;
                     }
                     if (!lit) {
@@ -972,9 +978,7 @@ bool HandSegmenter::unlitHandAt(const cv::Mat& texture, const cv::Mat& subtracti
                                 int bx) {
     // No projector light: the table in the hand's shadow, or the hand over black content. Both are lit by
     // the room alone, as the table beyond the projection is, and the skin's chromaticity is its block's.
-    if (!unlitTableMeasured_)
-        measureUnlitTable(texture);
-    if (!unlitTableKnown_)
+    if (!roomLightKnown(texture))
         return false;
     const int channels = texture.channels();
     const uchar* value = texture.ptr<uchar>(y) + x * channels;
@@ -986,6 +990,12 @@ bool HandSegmenter::unlitHandAt(const cv::Mat& texture, const cv::Mat& subtracti
     return unlitTableDistance > unlitTableSpread_ && stillAt(subtraction, x, y) &&
            kUnlitSkinRatio * chromaticityDistanceSquared(pixel, blockFeature(texture, by, bx)) <
                unlitTableDistance;
+}
+
+bool HandSegmenter::roomLightKnown(const cv::Mat& texture) {
+    if (!unlitTableMeasured_)
+        measureUnlitTable(texture);
+    return unlitTableKnown_;
 }
 
 bool HandSegmenter::stillAt(const cv::Mat& subtraction, int x, int y) const {

@@ -128,10 +128,13 @@ private:
     float nearestTableColour(const cv::Mat& texture, int block, int reach, IsSample isSample);
     // unlitTableChromaticity_ and unlitTableSpread_ receive the table's colour where only the room lights it,
     // from the view beyond the projection (unlitTableKnown_: there is one). Measured once per frame, when the
-    // first unlit pixel deep inside a hand asks for it.
+    // first unlit pixel of the hand's blocks asks for it.
     void measureUnlitTable(const cv::Mat& texture);
-    // Whether the pixel (x, y) of block (bx, by) deep inside the hand, which gets no projector light, is
-    // the hand's by its colour in the room's light.
+    // Whether the table's colour in the room's light alone is known (measured on first use in a pair): not
+    // with a gray camera or without a view beyond the projection.
+    bool roomLightKnown(const cv::Mat& texture);
+    // Whether the pixel (x, y) of block (bx, by), which gets no projector light, is the hand's by its colour
+    // in the room's light: deep inside the hand, or in a faint block joined to it by colour.
     bool unlitHandAt(const cv::Mat& texture, const cv::Mat& subtraction, int x, int y, int by, int bx);
     // Whether S around the pixel holds nothing but noise about the level where nothing is lit.
     bool stillAt(const cv::Mat& subtraction, int x, int y) const;
