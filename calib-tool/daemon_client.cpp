@@ -168,6 +168,16 @@ std::optional<Failure> DaemonClient::saveCalibration() {
     return std::nullopt;
 }
 
+std::optional<Failure> DaemonClient::showAccuracyTargets(bool show) {
+    io::UniqueBusError error;
+    const int r = sd_bus_call_method(bus_.get(), bus::kBusName, bus::kObjectPath, bus::kInterface,
+                                     bus::kMethodShowAccuracyTargets, error.get(), nullptr, "b", show);
+    if (r < 0)
+        return explain(error, r,
+                       show ? "Showing the accuracy test's circles" : "Hiding the accuracy test's circles");
+    return std::nullopt;
+}
+
 namespace {
 
 struct CalibrationFollower {

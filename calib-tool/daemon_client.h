@@ -58,6 +58,9 @@ public:
     std::optional<Failure> setTouchHeightMm(double heightMm);
     std::optional<Failure> snapshot(const std::string& what, int fd);
     std::optional<Failure> saveCalibration();
+    // Has the projector show the accuracy test's circles (until showAccuracyTargets(false) or this client
+    // leaves the bus), or the display again.
+    std::optional<Failure> showAccuracyTargets(bool show);
 
     struct CalibrationOptions {
         std::optional<std::uint32_t> frames;

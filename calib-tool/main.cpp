@@ -20,6 +20,7 @@
 
 #include "accuracy_report.h"
 #include "accuracy_rig.h"
+#include "calibration_remarks.h"
 #include "contacts_view.h"
 #include "daemon_client.h"
 #include "io/handles.h"
@@ -172,6 +173,8 @@ int calibrate(const std::string& step, const DaemonClient::CalibrationOptions& o
         return report({calib::kExitFailure,
                        "Calibration failed: " + result.message + ". The previous calibration stays active."});
     std::printf("Calibrated: RMS reprojection error %.2f px.\n", result.rmsPx);
+    for (const std::string& remark : calib::remarksOf(result.message))
+        std::printf("%s.\n", remark.c_str());
     if (!save)
         return calib::kExitOk;
     if (auto failure = daemon.saveCalibration())
@@ -211,8 +214,10 @@ int accuracyTest(double timeoutS, const std::optional<std::filesystem::path>& js
     if (auto* failure = std::get_if<Failure>(&properties))
         return report(*failure);
     const std::string rig = textProperty(std::get<0>(properties), bus::kPropertyRig);
-    if (const std::optional<std::string> problem = calib::accuracyTestRigProblem(rig))
+    const auto testRig = calib::accuracyTestRig(rig);
+    if (const auto* problem = std::get_if<std::string>(&testRig))
         return report({calib::kExitFailure, *problem + "."});
+    const bool camera = std::get<calib::AccuracyTestRig>(testRig) == calib::AccuracyTestRig::Camera;
     if (const std::string state = textProperty(std::get<0>(properties), bus::kPropertyState);
         state != "running")
         return report({calib::kExitFailure, "everytouchd is not detecting touches (it is " + state +
@@ -233,10 +238,15 @@ int accuracyTest(double timeoutS, const std::optional<std::filesystem::path>& js
              "everytouchd knows no display: it is not calibrated. Run \"everytouch-calib calibrate\" "
              "first."});
     run.score = calib::scoreTaps(run.targets, {});
+    // The daemon shows them until this tool says so or leaves the bus, however it ends.
+    if (camera)
+        if (const std::optional<Failure> failure = daemon.showAccuracyTargets(true))
+            return report(*failure);
     std::fprintf(
-        stderr,
-        "Waiting for a tap on each of the %zu circles (the simulated hand taps them), at most %g s.\n",
-        run.targets.centres.size(), timeoutS);
+        stderr, "Waiting for a tap on each of the %zu circles (%s), at most %g s.\n",
+        run.targets.centres.size(),
+        camera ? "tap the centre of each circle the projector shows, once" : "the simulated hand taps them",
+        timeoutS);
 
     calib::TouchDownFinder finder;
     std::vector<calib::TouchDown> touchDowns;
@@ -260,6 +270,9 @@ int accuracyTest(double timeoutS, const std::optional<std::filesystem::path>& js
     run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (failure)
         return report(*failure);
+    if (camera)
+        if (const std::optional<Failure> hidden = daemon.showAccuracyTargets(false))
+            return report(*hidden);
 
     calib::printAccuracyReport(stdout, run);
     if (jsonFile) {
@@ -340,8 +353,8 @@ int main(int argc, char** argv) {
     CLI::App* testCommand =
         app.add_subcommand("test",
                            "The paper's accuracy test: one tap on each of 35 circles, scored as epsilon "
-                           "(display px and mm), FRR and FAR; in this build on the simulated rig only "
-                           "(everytouchd --rig sim:grid35)");
+                           "(display px and mm), FRR and FAR; on a camera rig its projector shows the "
+                           "circles, on the simulated rig (everytouchd --rig sim:grid35) its hand taps them");
     testCommand
         ->add_option("--timeout-s", timeoutS, "Stop after S seconds even when some circles have no tap")
         ->check(CLI::Range(0.001, 1e9))

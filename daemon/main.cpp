@@ -29,10 +29,12 @@ int main(int argc, char** argv) {
            "--output", options.outputs,
            "Send contacts to OUTPUT too: uinput (the virtual touchscreen; overrides [Output] Uinput=)")
         ->delimiter(',');
-    app.add_option("--projector", options.projector,
-                   "Projector output of a camera rig: none, external (it embeds the code itself), window or "
-                   "window:DISPLAY (a fullscreen window of everytouchd's own; overrides [Projector] Output= "
-                   "and Display=)");
+    app.add_option(
+        "--projector", options.projector,
+        "Projector output of a camera rig: none, external (it embeds the code itself), window or "
+        "window:DISPLAY (a fullscreen window of everytouchd's own), overlay or overlay:DISPLAY (the "
+        "code over the X11 desktop, through its compositing manager); overrides [Projector] Output= "
+        "and Display=");
     app.add_option("--record", options.recordDir, "Record every frame into the new directory DIR");
     app.add_option("--frames", options.maxFrames, "Stop after N camera frames (0: run until the rig ends)");
     app.add_flag("--fast", options.fast, "Do not pace sim and replay rigs in real time");

@@ -14,6 +14,7 @@ packages=(
     build-essential cmake pkg-config clang-format
     libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
     libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools libsdl2-dev xvfb
+    libx11-dev libxext-dev libxfixes-dev libxrandr-dev libxpresent-dev libxtst-dev picom
     libcli11-dev nlohmann-json3-dev libinih-dev scdoc mandoc lintian
     dbus systemd udev
     qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils
@@ -155,12 +156,16 @@ sanitize)
         'TableSetUpStep\.AfterAnotherStepWaitsUntilTheBoardIsTakenAway'
         'TableSetUpStep\.AfterAnotherStepTakesABoardGoneBeforeItBegan'
         'EverytouchEval\.ARecordingWithoutAHandIsScoredNotRefused'
-        # The fake GigE camera rendering the simulated rig on its thread (minutes under ASan): the GigE path runs
-        # in the camera's other tests, detection in the pipeline's. The projector window: SDL2 unloads at its end
-        # the libraries it loaded, and LeakSanitizer reports what they keep in frames it cannot name; the window
-        # runs under the sanitizers in display_tests, without the leak check (tests/CMakeLists.txt).
+        # The fake GigE camera rendering the simulated rig on its thread (minutes under ASan, the camera lost
+        # meanwhile): the GigE path runs in the camera's other tests, detection in the pipeline's, the overlay in
+        # display_tests and AnOverlayNeedsAMonitorThatExistsAndACompositingManager. The projector window: SDL2
+        # unloads at its end the libraries it loaded, and LeakSanitizer reports what they keep in frames it
+        # cannot name; the window runs under the sanitizers in display_tests, without the leak check
+        # (tests/CMakeLists.txt).
         'CameraServiceTest\.DetectsTheSimulatedRigsTapThroughGigEVision'
         'CameraServiceTest\.CalibratesTheTableThroughItsProjectorWindow'
+        'CameraServiceTest\.CalibratesTheTableThroughItsOverlayAndMapsTheDisplayOntoTheWholeOutput'
+        'CameraServiceTest\.TheAccuracyTestsCirclesShowInTheProjectorWindowWhileItsClientRuns'
         'CameraServiceTest\.ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessboard'
         'CameraServiceTest\.AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration'
         # Measurements the normal build makes (9-11 s each): no allocation per pair over rendered pairs (the
@@ -201,20 +206,20 @@ tsan)
     install_missing_packages
     # The tests that run our code on several threads: the frame loop and what hands results between its
     # threads and the main loop, the recording's encoders and writer, the calibration job, the cameras'
-    # sources, the projector window and every test of the daemon binary. GLib, Aravis, GDAL and Mesa are not
+    # sources, the projector window and overlay and every test of the daemon binary. GLib, Aravis, GDAL and Mesa are not
     # built with ThreadSanitizer; tests/tsan-suppressions.txt names the reports it makes of their own
     # synchronisation. A new user's "calibrate full" renders some 2200 frames, over 300 s under
     # ThreadSanitizer; the projector step end to end runs the same code on fewer. The table
-    # calibrated through the projector window renders the simulated rig on the fake camera's thread, too
-    # slowly under ThreadSanitizer for the daemon to see frames; the window's threads run in display_tests
-    # and in the daemon's other window tests.
+    # calibrated through the projector window or the overlay renders the simulated rig on the fake camera's
+    # thread, too slowly under ThreadSanitizer for the daemon to see frames; the window's and the overlay's
+    # threads run in display_tests and in the daemon's other window and overlay tests.
     build build-tsan -DEVERYTOUCH_THREAD_SANITIZER=ON -DEVERYTOUCH_BUILD_BENCHMARKS=OFF \
         -DEVERYTOUCH_BUILD_DEVELOPER_TOOLS=OFF -DEVERYTOUCH_WERROR=OFF -DCMAKE_UNITY_BUILD=ON \
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
     TSAN_OPTIONS="suppressions=$PWD/tests/tsan-suppressions.txt halt_on_error=1" \
         ctest --test-dir build-tsan --output-on-failure -j "$jobs" \
-        -R '^(FrameLoop|FrameQueue|FrameTap|RecordingThread|CalibrationJob|CalibrationRunner|SnapshotRequests|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|WindowProjector|Everytouchd|EverytouchdConfig|EverytouchdService)' \
-        -E '^(ServiceTest\.ANewUserCalibratesFully|CameraServiceTest\.CalibratesTheTableThroughItsProjectorWindow)' "$@"
+        -R '^(FrameLoop|FrameQueue|FrameTap|RecordingThread|CalibrationJob|CalibrationRunner|SnapshotRequests|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|WindowProjector|OverlayProjector|Everytouchd|EverytouchdConfig|EverytouchdService)' \
+        -E '^(ServiceTest\.ANewUserCalibratesFully|CameraServiceTest\.CalibratesTheTableThrough)' "$@"
     ;;
 fuzz)
     # clang only for this command: the test suite replays the corpora in every build without it.

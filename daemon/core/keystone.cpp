@@ -1,5 +1,6 @@
 #include "core/keystone.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -7,6 +8,8 @@
 #include <vector>
 
 #include <Eigen/LU>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/geometry.h"
 
@@ -132,6 +135,41 @@ Result<KeystoneFit> fitDisplayToTable(const Calibration& calibration, cv::Size d
     fit.displayToProjector = tableToProjector * displayToTable;
     fit.displayToProjector /= fit.displayToProjector(2, 2);
     return fit;
+}
+
+DisplayShape displayShapeOnTable(const Calibration& calibration) {
+    const Eigen::Matrix3d displayToTable = calibration.displayToTableHomography();
+    const double w = calibration.displaySize.width, h = calibration.displaySize.height;
+    // Clockwise from the top left, on the display's outer pixel edges.
+    const std::array<Eigen::Vector2d, 4> corners = {applyHomography(displayToTable, {-0.5, -0.5}),
+                                                    applyHomography(displayToTable, {w - 0.5, -0.5}),
+                                                    applyHomography(displayToTable, {w - 0.5, h - 0.5}),
+                                                    applyHomography(displayToTable, {-0.5, h - 0.5})};
+    DisplayShape shape;
+    shape.topMm = (corners[1] - corners[0]).norm();
+    shape.rightMm = (corners[2] - corners[1]).norm();
+    shape.bottomMm = (corners[3] - corners[2]).norm();
+    shape.leftMm = (corners[0] - corners[3]).norm();
+    shape.leastCornerDeg = 180.0;
+    for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector2d toNext = corners[(k + 1) % 4] - corners[k];
+        const Eigen::Vector2d toPrevious = corners[(k + 3) % 4] - corners[k];
+        const double degrees =
+            std::acos(std::clamp(toNext.normalized().dot(toPrevious.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+        shape.leastCornerDeg = std::min(shape.leastCornerDeg, degrees);
+        shape.largestCornerDeg = std::max(shape.largestCornerDeg, degrees);
+    }
+    return shape;
+}
+
+cv::Mat drawThroughKeystone(const cv::Mat& displayImage, const Eigen::Matrix3d& displayToProjector,
+                            cv::Size panelSize) {
+    cv::Mat keystone;
+    cv::eigen2cv(displayToProjector, keystone);
+    cv::Mat image;
+    cv::warpPerspective(displayImage, image, keystone, panelSize, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                        cv::Scalar::all(0));
+    return image;
 }
 
 void checkDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {

@@ -31,6 +31,7 @@ using Bus = UniqueHandle<sd_bus, sd_bus_flush_close_unref>;
 using BusMessage = UniqueHandle<sd_bus_message, sd_bus_message_unref>;
 using BusSlot = UniqueHandle<sd_bus_slot, sd_bus_slot_unref>;
 using BusCreds = UniqueHandle<sd_bus_creds, sd_bus_creds_unref>;
+using BusTrack = UniqueHandle<sd_bus_track, sd_bus_track_unref>;
 using Event = UniqueHandle<sd_event, sd_event_unref>;
 using EventSource = UniqueHandle<sd_event_source, sd_event_source_disable_unref>;
 

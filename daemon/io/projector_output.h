@@ -1,5 +1,7 @@
 #pragma once
 
+#include <functional>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -28,6 +30,14 @@ public:
     // The projector panel, pixels.
     virtual cv::Size size() const = 0;
     virtual std::string describe() const = 0;
+    // Whether the desktop reaches the panel through setDisplayToProjector's keystone. An overlay over the
+    // desktop as it is does not warp it: a calibration made through it maps the display onto the whole panel.
+    virtual bool drawsDisplayThroughKeystone() const { return true; }
+    // Why the code is not on the table now, in words; nothing while it is. Safe to call from any thread.
+    virtual std::optional<std::string> problem() const { return std::nullopt; }
+    // `handler` is called, on the output's own thread, whenever problem() changes; an empty one ends the
+    // calls before this returns.
+    virtual void onProblemChange(std::function<void()> /*handler*/) {}
 };
 
 // Shows images on an output for as long as it lives and gives the projector back when it goes, however the

@@ -9,17 +9,14 @@
 #include <utility>
 #include <vector>
 
-#include <opencv2/core/eigen.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "core/embedding.h"
 #include "core/keystone.h"
-#include "core/pattern.h"
 #include "io/input_error.h"
+#include "io/kept_pattern.h"
 #include "io/log.h"
-#include "io/recording.h"
+#include "io/output_thread.h"
+#include "io/projector_image.h"
 #include "io/sdl_handles.h"
-#include "io/thread_name.h"
 
 namespace everytouch::io {
 
@@ -93,57 +90,19 @@ int findDisplay(const std::string& display) {
                      std::string("no such display on ") + SDL_GetCurrentVideoDriver() + "; it has " + known);
 }
 
-// The pattern of `seed` at `size`: as kept in `directory` by an earlier start, else generated and kept there.
-cv::Mat patternOf(std::uint64_t seed, cv::Size size, const std::filesystem::path& directory) {
-    const std::filesystem::path kept =
-        directory.empty()
-            ? std::filesystem::path()
-            : directory / ("pattern-seed" + std::to_string(seed) + "-" + std::to_string(size.width) + "x" +
-                           std::to_string(size.height) + ".png");
-    if (!kept.empty() && std::filesystem::exists(kept)) {
-        try {
-            return readPatternImage(kept, size);
-        } catch (const std::exception& error) {
-            ET_LOG(Warning) << error.what() << "; the code pattern is generated again";
-        }
-    }
-    core::PatternOptions options;
-    options.size = size;
-    options.seed = seed;
-    cv::Mat pattern = core::generatePattern(options);
-    if (!kept.empty()) {
-        try {
-            writePatternImage(kept, pattern);
-        } catch (const std::exception& error) {
-            ET_LOG(Warning) << "the code pattern is not kept for the next start: " << error.what();
-        }
-    }
-    return pattern;
-}
-
 }  // namespace
 
 WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed, int delta,
                                  const std::filesystem::path& patternDirectory)
     : delta_(delta) {
-    if (delta < 1 || delta > 127)
-        throw InputError("[Projector] Delta=", std::to_string(delta), "expected 1 to 127 levels");
-    std::promise<Opened> opened;
-    std::future<Opened> result = opened.get_future();
-    thread_ = std::thread([this, display, &opened] {
-        nameThisThread("et-projector");
-        run(display, opened);
-    });
+    checkCodeDelta(delta);
+    OpenedOutput opened =
+        startOutputThread(thread_, "et-projector",
+                          [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
+    size_ = opened.size;
+    description_ = std::move(opened.description);
     try {
-        Opened window = result.get();
-        size_ = window.size;
-        description_ = std::move(window.description);
-    } catch (...) {
-        thread_.join();
-        throw;
-    }
-    try {
-        pattern_ = patternOf(seed, size_, patternDirectory);
+        pattern_ = keptPattern(seed, size_, patternDirectory);
         embedAndHandOver(idleImage());
     } catch (...) {
         stopping_ = true;
@@ -169,17 +128,7 @@ void WindowProjector::setDisplayToProjector(cv::Size displaySize, const Eigen::M
 }
 
 void WindowProjector::show(const cv::Mat& projectorImage) {
-    if (projectorImage.size() != size_ ||
-        (projectorImage.type() != CV_8UC1 && projectorImage.type() != CV_8UC3))
-        throw std::invalid_argument(
-            "projector image: expected an 8-bit gray or BGR image of " + std::to_string(size_.width) + "x" +
-            std::to_string(size_.height) + " pixels, got " + std::to_string(projectorImage.cols) + "x" +
-            std::to_string(projectorImage.rows) + " of type " + std::to_string(projectorImage.type()));
-    cv::Mat colour;
-    if (projectorImage.type() == CV_8UC1)
-        cv::cvtColor(projectorImage, colour, cv::COLOR_GRAY2BGR);
-    else
-        colour = projectorImage;
+    const cv::Mat colour = projectorImageInColour(projectorImage, size_);
     showing_ = true;
     embedAndHandOver(colour);
 }
@@ -196,12 +145,8 @@ void WindowProjector::release() noexcept {
 cv::Mat WindowProjector::idleImage() const {
     if (displaySize_.empty())
         return cv::Mat(size_, CV_8UC3, cv::Scalar::all(255));
-    cv::Mat keystone;
-    cv::eigen2cv(displayToProjector_, keystone);
-    cv::Mat image;
-    cv::warpPerspective(cv::Mat(displaySize_, CV_8UC3, cv::Scalar::all(255)), image, keystone, size_,
-                        cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar::all(0));
-    return image;
+    return core::drawThroughKeystone(cv::Mat(displaySize_, CV_8UC3, cv::Scalar::all(255)),
+                                     displayToProjector_, size_);
 }
 
 void WindowProjector::embedAndHandOver(const cv::Mat& content) {
@@ -213,7 +158,7 @@ void WindowProjector::embedAndHandOver(const cv::Mat& content) {
     fresh_ = true;
 }
 
-void WindowProjector::run(const std::string& display, std::promise<Opened>& opened) {
+void WindowProjector::run(const std::string& display, std::promise<OpenedOutput>& opened) {
     std::optional<SdlVideo> video;
     SdlWindow window;
     SdlRenderer renderer;
@@ -256,7 +201,7 @@ void WindowProjector::run(const std::string& display, std::promise<Opened>& open
         SDL_GetRendererInfo(renderer.get(), &info);
         description = "the window on " + std::string(SDL_GetCurrentVideoDriver()) + " display " +
                       describeDisplay(index) + " at " + std::to_string(refreshHz) + " Hz (" + info.name + ")";
-        opened.set_value(Opened{cv::Size(width, height), description});
+        opened.set_value(OpenedOutput{cv::Size(width, height), description});
     } catch (...) {
         opened.set_exception(std::current_exception());
         return;

@@ -8,6 +8,7 @@
 #include <string>
 #include <thread>
 
+#include "io/output_thread.h"
 #include "io/projector_output.h"
 
 namespace everytouch::io {
@@ -44,11 +45,7 @@ public:
     const cv::Mat& pattern() const { return pattern_; }
 
 private:
-    struct Opened {
-        cv::Size size;
-        std::string description;
-    };
-    void run(const std::string& display, std::promise<Opened>& opened);
+    void run(const std::string& display, std::promise<OpenedOutput>& opened);
     // The white display area through the keystone, black around it.
     cv::Mat idleImage() const;
     void embedAndHandOver(const cv::Mat& content);

@@ -42,6 +42,7 @@ inline constexpr const char* kMethodSaveCalibration = "SaveCalibration";
 inline constexpr const char* kMethodResetCalibration = "ResetCalibration";
 inline constexpr const char* kMethodReloadConfig = "ReloadConfig";
 inline constexpr const char* kMethodSnapshot = "Snapshot";
+inline constexpr const char* kMethodShowAccuracyTargets = "ShowAccuracyTargets";
 
 // Signals.
 inline constexpr const char* kSignalContacts = "Contacts";

@@ -181,6 +181,22 @@ int methodSnapshot(sd_bus_message* message, void* userdata, sd_bus_error* error)
     });
 }
 
+int methodShowAccuracyTargets(sd_bus_message* message, void* userdata, sd_bus_error* error) noexcept {
+    return guarded(error, [&] {
+        BusService& service = serviceOf(userdata);
+        service.requirePrivileged(message, "Showing the accuracy test's circles");
+        int show = 0;
+        checkBusCall(sd_bus_message_read(message, "b", &show), "ShowAccuracyTargets show");
+        service.showAccuracyTargets(message, show != 0);
+        return sd_bus_reply_method_return(message, nullptr);
+    });
+}
+
+int onAccuracyTargetsClientGone(sd_bus_track* /*track*/, void* userdata) noexcept {
+    serviceOf(userdata).daemon().hideAccuracyTargets();
+    return 0;
+}
+
 const sd_bus_vtable kVtable[] = {
     SD_BUS_VTABLE_START(0),
     SD_BUS_PROPERTY(bus::kPropertyApiVersion, "u", getApiVersion, 0, SD_BUS_VTABLE_PROPERTY_CONST),
@@ -209,6 +225,8 @@ const sd_bus_vtable kVtable[] = {
                             SD_BUS_VTABLE_UNPRIVILEGED),
     SD_BUS_METHOD_WITH_ARGS(bus::kMethodSnapshot, SD_BUS_ARGS("s", what, "h", fd), SD_BUS_NO_RESULT,
                             methodSnapshot, SD_BUS_VTABLE_UNPRIVILEGED),
+    SD_BUS_METHOD_WITH_ARGS(bus::kMethodShowAccuracyTargets, SD_BUS_ARGS("b", show), SD_BUS_NO_RESULT,
+                            methodShowAccuracyTargets, SD_BUS_VTABLE_UNPRIVILEGED),
     SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalContacts, SD_BUS_ARGS("a(uddbd)", contacts), 0),
     SD_BUS_SIGNAL_WITH_ARGS(bus::kSignalCalibrationProgress,
                             SD_BUS_ARGS("s", step, "d", fraction, "s", message), 0),
@@ -252,6 +270,24 @@ int BusService::connect(sd_event* event, std::string& failedStep) {
         ET_LOG(Notice) << "there is no group \"" << authorization_.groupName()
                        << "\": only root may calibrate or change settings";
     return 0;
+}
+
+void BusService::showAccuracyTargets(sd_bus_message* call, bool show) {
+    accuracyTargetsClient_.reset();
+    if (!show) {
+        daemon_.hideAccuracyTargets();
+        return;
+    }
+    daemon_.showAccuracyTargets();
+    // The circles go when the client that asked for them leaves the bus, however it ends.
+    sd_bus_track* track = nullptr;
+    int r = sd_bus_track_new(sd_bus_message_get_bus(call), &track, onAccuracyTargetsClientGone, this);
+    io::BusTrack owned(track);
+    if (r < 0 || (r = sd_bus_track_add_sender(track, call)) < 0) {
+        daemon_.hideAccuracyTargets();
+        checkBusCall(r, "following the client that shows the accuracy test's circles");
+    }
+    accuracyTargetsClient_ = std::move(owned);
 }
 
 void BusService::requirePrivileged(sd_bus_message* message, const char* action) const {

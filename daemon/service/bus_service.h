@@ -35,6 +35,9 @@ public:
     void reply(sd_bus_message* call);
     void replyError(sd_bus_message* call, const char* name, const std::string& message);
 
+    // Shows the accuracy test's circles for the sender of `call` until it asks to hide them or leaves the
+    // bus, or hides them. Throws BusError.
+    void showAccuracyTargets(sd_bus_message* call, bool show);
     // Throws BusError(AccessDenied) unless the sender of `message` may change the daemon's state.
     void requirePrivileged(sd_bus_message* message, const char* action) const;
 
@@ -45,6 +48,7 @@ private:
     SenderAuthorization authorization_;
     io::Bus bus_;
     io::BusSlot objectSlot_;
+    io::BusTrack accuracyTargetsClient_;  // who asked for the accuracy test's circles
 };
 
 }  // namespace everytouch::service

@@ -186,12 +186,10 @@ const std::vector<KeySpec>& keySpecs() {
          }},
         {"Projector", "Output",
          [](DaemonConfig& config, const std::string& value) {
-             if (value == "overlay")
-                 throw BadValue{value + " is not part of this build yet; it knows none, external and window"};
              const std::optional<ProjectorOutput> output =
                  value.empty() ? ProjectorOutput::None : parseProjectorOutput(value);
              if (!output)
-                 throw BadValue{"expected none, external or window, found \"" + value + "\""};
+                 throw BadValue{"expected none, external, window or overlay, found \"" + value + "\""};
              config.projector.output = *output;
          }},
         {"Projector", "Display",
@@ -332,6 +330,8 @@ std::optional<ProjectorOutput> parseProjectorOutput(std::string_view name) {
         return ProjectorOutput::External;
     if (name == "window")
         return ProjectorOutput::Window;
+    if (name == "overlay")
+        return ProjectorOutput::Overlay;
     return std::nullopt;
 }
 

@@ -30,11 +30,12 @@ inline constexpr int kMinRegionSide = 64;
 
 // Where the code comes from on a camera rig ([Projector] Output=): nowhere the daemon knows of, a projector
 // that embeds it itself (a DLP development kit's pattern sequence, a media server) from the pattern of a
-// seed, or the daemon's own fullscreen window on the projector's output, which also shows the calibration
-// images.
-enum class ProjectorOutput { None, External, Window };
+// seed, the daemon's own fullscreen window on the projector's output, which also shows the calibration
+// images, or the daemon's translucent overlay over the desktop on that output (X11, through its compositing
+// manager), which shows them too.
+enum class ProjectorOutput { None, External, Window, Overlay };
 
-// "none", "external" or "window"; nothing for any other name.
+// "none", "external", "window" or "overlay"; nothing for any other name.
 std::optional<ProjectorOutput> parseProjectorOutput(std::string_view name);
 
 struct ProjectorConfig {

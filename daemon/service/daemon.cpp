@@ -11,6 +11,8 @@
 #include <cstring>
 #include <system_error>
 
+#include "core/accuracy_targets.h"
+#include "core/keystone.h"
 #include "core/pattern.h"
 #include "io/input_error.h"
 #include "io/log.h"
@@ -41,6 +43,16 @@ std::string formatDouble(const char* format, double value) {
     return text;
 }
 
+// How the unwarped display lands on the table, for whoever sets the projector's own keystone.
+std::string describeShape(const core::DisplayShape& shape) {
+    return "the display lands on the table with sides of " + formatDouble("%.0f", shape.topMm) + " (top), " +
+           formatDouble("%.0f", shape.bottomMm) + " (bottom), " + formatDouble("%.0f", shape.leftMm) +
+           " (left) and " + formatDouble("%.0f", shape.rightMm) + " mm (right), its corners " +
+           formatDouble("%.1f", shape.leastCornerDeg) + " to " +
+           formatDouble("%.1f", shape.largestCornerDeg) +
+           " degrees: the projector's own keystone makes it an upright rectangle";
+}
+
 }  // namespace
 
 const char* toString(DaemonState state) {
@@ -62,6 +74,8 @@ const char* toString(DaemonState state) {
 Daemon::Daemon(DaemonOptions options) : options_(std::move(options)) {}
 
 Daemon::~Daemon() {
+    if (projector_)
+        projector_->onProblemChange({});  // the inbox it posts to goes before the projector
     shutDown();
 }
 
@@ -93,11 +107,12 @@ int Daemon::run() {
     const io::RigSpec spec = io::RigSpec::parse(rigText);
     rigName_ = spec.toString();
     cameraRig_ = spec.kind == io::RigSpec::Kind::Aravis || spec.kind == io::RigSpec::Kind::V4l2;
-    if (cameraRig_ && config_.projector.output == ProjectorOutput::Window) {
-        // At the first start on an output the window's code pattern is generated before the daemon is ready:
-        // under a second at 640x480, about a minute at 1920x1080. systemd's start timeout waits that long.
+    if (cameraRig_ && (config_.projector.output == ProjectorOutput::Window ||
+                       config_.projector.output == ProjectorOutput::Overlay)) {
+        // At the first start on an output the code pattern is generated before the daemon is ready: under a
+        // second at 640x480, about a minute at 1920x1080. systemd's start timeout waits that long.
         sd_notify(0,
-                  "EXTEND_TIMEOUT_USEC=300000000\nSTATUS=Opening the projector window (at the first start on "
+                  "EXTEND_TIMEOUT_USEC=300000000\nSTATUS=Opening the projector output (at the first start on "
                   "an output its code pattern takes up to a minute or two on a large panel)");
     }
     if (!cameraRig_ && config_.projector.output != ProjectorOutput::None)
@@ -118,7 +133,7 @@ int Daemon::run() {
     if (!pattern_.empty() && cameraRig_)
         ET_LOG(Info) << "code: the pattern of seed " << config_.projector.seed << " on the projector's "
                      << pattern_.cols << "x" << pattern_.rows << " pixels, " << config_.projector.delta
-                     << " levels, embedded by the projector window";
+                     << " levels, embedded by " << projector_->describe();
     if (projector_)
         projectorSize_ = projector_->size();
     else if (rig)
@@ -143,6 +158,8 @@ int Daemon::run() {
     }
     if (const int r = startEventLoop(); r < 0)
         throw std::system_error(-r, std::generic_category(), "Failed to set up the event loop");
+    if (projector_)
+        projector_->onProblemChange([this] { inbox_.post([this] { refreshState(); }); });
     connectBus();
     startFrameLoop(openOutputs());
     startWatchdog();
@@ -370,8 +387,8 @@ DaemonState Daemon::state() const {
         return DaemonState::Calibrating;
     // Detection runs on every pair once calibrated with the code known, unless a stage keeps failing, the
     // camera is gone or stalled, or its frames do not fit the calibration.
-    if (!calibrated() || pattern_.empty() || !loop_ || loop_->failing() || loop_->sourceLost() ||
-        loop_->idle())
+    if (!calibrated() || pattern_.empty() || projectorProblem_ || !loop_ || loop_->failing() ||
+        loop_->sourceLost() || loop_->idle())
         return DaemonState::Degraded;
     // Detection goes on, but its touches land beside the fingers until someone calibrates.
     if (!loop_->calibrationProblem().empty())
@@ -386,10 +403,12 @@ std::string Daemon::stateReason() const {
                 return "camera lost, asking it again: " + *lost;
             if (!calibrated())
                 return "not calibrated (run everytouch-calib calibrate)";
+            if (projectorProblem_)
+                return "not detecting: " + *projectorProblem_;
             if (pattern_.empty() && cameraRig_)
-                return "not detecting (the projected code is not known: set [Projector] Output=window for "
-                       "the daemon's own projector window, or external for a projector that embeds it, see "
-                       "everytouchd.conf(5))";
+                return "not detecting (the projected code is not known: set [Projector] Output=overlay for "
+                       "the code over the desktop, window for the daemon's own projector window, or external "
+                       "for a projector that embeds it, see everytouchd.conf(5))";
             if (const std::string problem = loop_ ? loop_->calibrationProblem() : std::string();
                 !problem.empty() && !loop_->idle() && !loop_->failing())
                 return "the calibration no longer fits: " + problem +
@@ -404,7 +423,8 @@ std::string Daemon::stateReason() const {
 }
 
 core::PipelineSettings Daemon::pipelineSettings() const {
-    return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_, calibration_ == nullptr};
+    return core::PipelineSettings{store_->active(), pattern_, touchHeightMm_,
+                                  calibration_ == nullptr && !projectorProblem_};
 }
 
 const std::optional<core::Calibration>& Daemon::activeCalibration() const {
@@ -419,6 +439,11 @@ LoopStatistics Daemon::statistics() const {
 void Daemon::refreshState() {
     if (!ready_)
         return;
+    if (std::optional<std::string> now = projector_ ? projector_->problem() : std::nullopt;
+        now != projectorProblem_) {
+        projectorProblem_ = std::move(now);
+        applySettings();  // no detection, and no contact held, while the table shows no code
+    }
     std::vector<const char*> changed;
     if (const DaemonState now = state(); now != reportedState_) {
         reportedState_ = now;
@@ -575,6 +600,7 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
             "The projector's size is unknown: this rig has no projector output and no calibration");
 
     const cv::Size projectorSize = !projectorSize_.empty() ? projectorSize_ : store_->active()->projectorSize;
+    accuracyTargetsShown_ = false;  // the calibration's images replace them and give the display back
     calibration_ = std::make_unique<CalibrationRunner>(
         loop_->tap(), projector_.get(), kQueueFrames,
         CalibrationJob{std::move(*steps), options, store_->active(), projectorSize},
@@ -591,22 +617,57 @@ void Daemon::calibrate(std::string_view request, const CalibrationOptions& optio
     refreshState();
 }
 
+void Daemon::showAccuracyTargets() {
+    if (calibration_)
+        throw BusError(bus::kErrorBusy, "A calibration is running; wait for its CalibrationFinished signal");
+    if (!projector_)
+        throw BusError(SD_BUS_ERROR_NOT_SUPPORTED,
+                       "This rig has no projector output to show the accuracy test's circles on; a recording "
+                       "shows what it shows");
+    if (!store_->active())
+        throw BusError(bus::kErrorNotCalibrated,
+                       "The circles are drawn over the display through the calibration, and there is none; "
+                       "calibrate first");
+    const core::Calibration& calibration = *store_->active();
+    projector_->show(core::drawThroughKeystone(core::drawAccuracyTargets(calibration.displaySize),
+                                               calibration.displayToProjector, projector_->size()));
+    if (!accuracyTargetsShown_)
+        ET_LOG(Info) << "the accuracy test's circles are on " << projector_->describe();
+    accuracyTargetsShown_ = true;
+}
+
+void Daemon::hideAccuracyTargets() noexcept {
+    if (!accuracyTargetsShown_)
+        return;
+    accuracyTargetsShown_ = false;
+    projector_->release();
+    ET_LOG(Info) << "the accuracy test's circles are gone; " << projector_->describe()
+                 << " shows the display";
+}
+
 void Daemon::finishCalibration(const CalibrationOutcome& outcome) {
     if (!calibration_)
         return;
     calibration_.reset();
+    std::string message = outcome.message;
     if (outcome.ok) {
-        store_->activate(*outcome.calibration);
-        drawDisplayThrough(*outcome.calibration);
-        adoptExternalCode(*outcome.calibration);
-        ET_LOG(Notice) << outcome.message << "; SaveCalibration keeps it";
+        core::Calibration calibration = *outcome.calibration;
+        if (projector_ && !projector_->drawsDisplayThroughKeystone()) {
+            // The desktop reaches the panel as it is, not through the keystone the table step fitted.
+            calibration.displaySize = calibration.projectorSize;
+            calibration.displayToProjector = Eigen::Matrix3d::Identity();
+            message += "; " + describeShape(core::displayShapeOnTable(calibration));
+        }
+        store_->activate(calibration);
+        drawDisplayThrough(calibration);
+        adoptExternalCode(calibration);
+        ET_LOG(Notice) << message << "; SaveCalibration keeps it";
     } else {
-        ET_LOG(Warning) << "calibration failed: " << outcome.message
-                        << "; the previous calibration stays active";
+        ET_LOG(Warning) << "calibration failed: " << message << "; the previous calibration stays active";
     }
     applySettings();  // detection again, with the new calibration if there is one
     if (bus_)
-        bus_->calibrationFinished(outcome.ok, outcome.message, outcome.rmsPx);
+        bus_->calibrationFinished(outcome.ok, message, outcome.rmsPx);
     refreshState();
 }
 

@@ -87,6 +87,10 @@ public:
     void reloadConfig();
     // Replies to `call` once the next frame pair has been written to `fd` as a PNG.
     void snapshot(sd_bus_message* call, std::string_view what, int fd);
+    // The accuracy test's circles on the projector, over the display through the active calibration, while
+    // detection goes on: until hideAccuracyTargets() or a calibration starts.
+    void showAccuracyTargets();
+    void hideAccuracyTargets() noexcept;
 
 private:
     void loadCalibration(const std::optional<io::RigDescription>& rig);
@@ -138,8 +142,11 @@ private:
 
     std::unique_ptr<io::FrameSource> source_;
     std::unique_ptr<io::ProjectorOutput> projector_;  // none for a recording
-    bool recordedRig_ = false;                        // the frames come from a recording
-    cv::Size projectorSize_;                          // the panel calibration images are drawn for
+    // Why the projector shows no code now, as last seen: no detection meanwhile.
+    std::optional<std::string> projectorProblem_;
+    bool accuracyTargetsShown_ = false;
+    bool recordedRig_ = false;  // the frames come from a recording
+    cv::Size projectorSize_;    // the panel calibration images are drawn for
     std::unique_ptr<io::RecordingWriter> recorder_;
     std::unique_ptr<io::ConsoleSink> console_;
     std::unique_ptr<io::TouchLogWriter> touchLog_;

@@ -32,13 +32,17 @@ std::optional<std::string> DaemonOptions::validate() const {
 void applyProjectorOption(const std::string& option, ProjectorConfig& projector) {
     const std::size_t colon = option.find(':');
     const std::string output = option.substr(0, colon);
-    if (colon != std::string::npos && output != "window")
-        throw io::InputError("--projector", "",
-                             "only a window takes a display (window:DISPLAY), not \"" + option + "\"");
+    if (colon != std::string::npos && output != "window" && output != "overlay")
+        throw io::InputError(
+            "--projector", "",
+            "only a window or an overlay takes a display (window:DISPLAY, overlay:DISPLAY), not \"" + option +
+                "\"");
     const std::optional<ProjectorOutput> parsed = parseProjectorOutput(output);
     if (!parsed)
-        throw io::InputError("--projector", "",
-                             "expected none, external, window or window:DISPLAY, found \"" + option + "\"");
+        throw io::InputError(
+            "--projector", "",
+            "expected none, external, window, window:DISPLAY, overlay or overlay:DISPLAY, found \"" + option +
+                "\"");
     projector.output = *parsed;
     if (colon != std::string::npos)
         projector.display = option.substr(colon + 1);

@@ -35,8 +35,9 @@ struct DaemonOptions {
     std::optional<std::string> validate() const;
 };
 
-// Sets [Projector] Output= (and Display= for a window) from a --projector value: none, external,
-// window or window:DISPLAY. Throws io::InputError naming --projector for anything else.
+// Sets [Projector] Output= (and Display= for a window or an overlay) from a --projector value: none,
+// external, window, window:DISPLAY, overlay or overlay:DISPLAY. Throws io::InputError naming --projector for
+// anything else.
 void applyProjectorOption(const std::string& option, ProjectorConfig& projector);
 
 }  // namespace everytouch::service

@@ -2,6 +2,7 @@
 
 #include "io/aravis_source.h"
 #include "io/input_error.h"
+#include "io/overlay_projector.h"
 #include "io/replay_source.h"
 #include "io/sim_projector.h"
 #include "io/sim_source.h"
@@ -14,6 +15,13 @@ namespace {
 
 void openCameraProjector(const ProjectorConfig& projector, const std::filesystem::path& stateDirectory,
                          OpenedRig& rig) {
+    if (projector.output == ProjectorOutput::Overlay) {
+        auto overlay = std::make_unique<io::OverlayProjector>(projector.display, projector.seed,
+                                                              projector.delta, stateDirectory);
+        rig.pattern = overlay->pattern();
+        rig.projector = std::move(overlay);
+        return;
+    }
     if (projector.output != ProjectorOutput::Window)
         return;
     auto window = std::make_unique<io::WindowProjector>(projector.display, projector.seed, projector.delta,

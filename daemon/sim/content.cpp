@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/accuracy_grid.h"
+#include "core/accuracy_targets.h"
 
 namespace everytouch::sim {
 
@@ -262,19 +263,8 @@ cv::Mat renderContent(ContentKind kind, cv::Size size, std::uint64_t seed, int v
                 static_cast<std::uint64_t>(kind));
     const double scale = size.width / 640.0;
     switch (kind) {
-        case ContentKind::Grid35: {
-            cv::Mat image(size, CV_8UC3, cv::Scalar(245, 245, 245));
-            const int radius =
-                static_cast<int>(std::lround(core::accuracyGridCircleRadius(size.width, size.height)));
-            for (const cv::Point2d& centre : grid35Centres(size)) {
-                const cv::Point c(static_cast<int>(std::lround(centre.x)),
-                                  static_cast<int>(std::lround(centre.y)));
-                cv::circle(image, c, radius, cv::Scalar(60, 60, 60), std::max(1, static_cast<int>(2 * scale)),
-                           cv::LINE_AA);
-                cv::drawMarker(image, c, cv::Scalar(40, 40, 200), cv::MARKER_CROSS, radius, 1, cv::LINE_AA);
-            }
-            return image;
-        }
+        case ContentKind::Grid35:
+            return core::drawAccuracyTargets(size);
         case ContentKind::Shapes: {
             cv::Mat image(size, CV_8UC3, cv::Scalar(245, 245, 245));
             for (const auto& shape : dragShapes(size)) {

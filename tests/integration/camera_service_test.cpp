@@ -22,6 +22,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "core/accuracy_targets.h"
+#include "core/code_overlay.h"
 #include "core/embedding.h"
 #include "core/pattern.h"
 #include "core/projector_chessboard.h"
@@ -31,10 +33,13 @@
 #include "sim/simulator.h"
 #include "support/bus_commands.h"
 #include "support/calibration_checks.h"
+#include "support/compositor.h"
+#include "support/desktop_window.h"
 #include "support/fake_gige_camera.h"
 #include "support/notify_socket.h"
 #include "support/private_bus.h"
 #include "support/process.h"
+#include "support/screen_grabs.h"
 #include "support/temp_dir.h"
 #include "support/virtual_display.h"
 
@@ -198,7 +203,7 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
     ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
     EXPECT_THAT(get("StateReason"),
-                HasSubstr("the projected code is not known: set [Projector] Output=window"));
+                HasSubstr("the projected code is not known: set [Projector] Output=overlay"));
     EXPECT_FALSE(std::filesystem::exists(dir_ / "pattern.png"));
     daemon_->signal(SIGTERM);
     ASSERT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
@@ -440,6 +445,20 @@ cv::Mat windowContent(const test::VirtualDisplay& display) {
     return first;
 }
 
+// A GigE Vision camera whose frames the simulated rig renders, its projector showing what the screen shows.
+std::unique_ptr<test::FakeGigeCamera> filmingTheScreen(const sim::SimParameters& rig,
+                                                       std::shared_ptr<sim::Simulator> simulator,
+                                                       std::shared_ptr<test::VirtualDisplay> display) {
+    return std::make_unique<test::FakeGigeCamera>(
+        rig.cameraSize, [simulator, display](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+            simulator->projectImage(windowContent(*display));
+            core::Frame frame;
+            sim::FrameTruth truth;
+            simulator->render(frameId, frame, truth);
+            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
+        });
+}
+
 // The whole loop of a camera rig: everytouchd shows the table step's chessboard in its projector window (an
 // Xvfb of the test's own); the simulated rig projects what the window shows onto its table, where the card
 // lies, and its camera films it as a GigE Vision camera; the daemon finds the table's pose from those frames.
@@ -456,14 +475,7 @@ TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
     ::unsetenv("WAYLAND_DISPLAY");
 
     camera_.reset();
-    camera_ = std::make_unique<test::FakeGigeCamera>(
-        rig.cameraSize, [simulator, display](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
-            simulator->projectImage(windowContent(*display));
-            core::Frame frame;
-            sim::FrameTruth truth;
-            simulator->render(frameId, frame, truth);
-            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
-        });
+    camera_ = filmingTheScreen(rig, simulator, display);
     startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
                 "[Projector]\nOutput=window\nSeed=" + std::to_string(rig.seed) +
                     "\nDelta=" + std::to_string(rig.delta) + "\n");
@@ -476,6 +488,124 @@ TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
     camera_.reset();
 }
 
+// The same loop through the code overlay over a desktop (picom composites it on the test's Xvfb): the table
+// step's chessboard shows opaque in the overlay, and since the desktop under the overlay is not warped, the
+// calibration maps the display onto the whole output.
+TEST_F(CameraServiceTest, CalibratesTheTableThroughItsOverlayAndMapsTheDisplayOntoTheWholeOutput) {
+    sim::SimParameters rig;
+    rig.scenario = "table-setup";
+    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
+    const core::Calibration truth = simulator->calibration();
+    const core::Calibration moved = test::withTheTableMoved(truth);
+    io::writeCalibrationFile(dir_ / "calibration.yml", moved);
+    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
+    ::setenv("DISPLAY", display->name().c_str(), 1);
+    ::unsetenv("WAYLAND_DISPLAY");
+    const cv::Mat picture(rig.projectorSize, CV_8UC3, cv::Scalar(200, 180, 160));
+    test::DesktopWindow desktop(display->name(), cv::Rect(cv::Point(), rig.projectorSize), picture);
+    test::Compositor compositor(display->name());
+
+    camera_.reset();
+    camera_ = filmingTheScreen(rig, simulator, display);
+    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
+                "[Projector]\nOutput=overlay\nSeed=" + std::to_string(rig.seed) +
+                    "\nDelta=" + std::to_string(rig.delta) + "\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_THAT(get("Projector"), HasSubstr("the overlay on the X server " + display->name() +
+                                            " monitor 0 \\\"screen\\\" (640x480)"));
+    // Between calibrations the desktop shows through, the code over it.
+    cv::Mat positive, negative;
+    core::makeCodeOverlay(sim::rigPattern(rig), rig.delta, positive, negative);
+    const test::AlternateGrabs grabbed = test::grabAlternates(
+        *display, test::compositedOver(positive, picture), test::compositedOver(negative, picture));
+    EXPECT_FALSE(grabbed.positive.empty() || grabbed.negative.empty())
+        << "the screen does not show the desktop with the code over it";
+
+    const test::ProcessResult calibrate = test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"});
+    test::expectTheTableFound(calibrate, dir_ / "calibration.yml", moved, truth);
+    // The projector's own keystone must square the display: the user is told how far it is.
+    EXPECT_THAT(calibrate.out, HasSubstr("\nThe display lands on the table with sides of "));
+    const core::Calibration calibrated = io::readCalibrationFile(dir_ / "calibration.yml");
+    EXPECT_EQ(calibrated.displaySize, rig.projectorSize);
+    EXPECT_TRUE(calibrated.displayToProjector.isApprox(Eigen::Matrix3d::Identity()))
+        << calibrated.displayToProjector;
+
+    // Without a compositing manager the overlay hides, and the state says why nothing is detected.
+    const auto reasonSays = [this](const std::string& text) {
+        const auto deadline = std::chrono::steady_clock::now() + 10s;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (get("StateReason").find(text) != std::string::npos)
+                return true;
+            std::this_thread::sleep_for(50ms);
+        }
+        return false;
+    };
+    compositor.stop();
+    EXPECT_TRUE(reasonSays("not detecting: no compositing manager runs on its X server"))
+        << get("StateReason");
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    const test::Compositor again(display->name());
+    EXPECT_TRUE(reasonSays("\"\"")) << "the state stays degraded once a compositing manager runs again: "
+                                    << get("StateReason");
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    camera_.reset();
+}
+
+// everytouch-calib test on a camera rig: the daemon's projector window shows the 35 circles over the display,
+// with the code, while the test runs, and the display again when it ends or its client dies.
+TEST_F(CameraServiceTest, TheAccuracyTestsCirclesShowInTheProjectorWindowWhileItsClientRuns) {
+    sim::SimParameters rig;
+    rig.scenario = "table-setup";
+    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
+    const core::Calibration truth = simulator->calibration();
+    io::writeCalibrationFile(dir_ / "calibration.yml", truth);
+    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
+    ::setenv("DISPLAY", display->name().c_str(), 1);
+    ::unsetenv("WAYLAND_DISPLAY");
+    camera_.reset();
+    camera_ = filmingTheScreen(rig, simulator, display);
+    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
+                "[Projector]\nOutput=window\nSeed=" + std::to_string(rig.seed) +
+                    "\nDelta=" + std::to_string(rig.delta) + "\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    const auto deadline = std::chrono::steady_clock::now() + 20s;
+    while (get("State") != "s \"running\"\n" && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(100ms);
+    ASSERT_EQ(get("State"), "s \"running\"\n") << get("StateReason");
+
+    cv::Mat keystone;
+    cv::eigen2cv(truth.displayToProjector, keystone);
+    cv::Mat targets, idle;
+    cv::warpPerspective(core::drawAccuracyTargets(truth.displaySize), targets, keystone, rig.projectorSize);
+    cv::warpPerspective(cv::Mat(truth.displaySize, CV_8UC3, cv::Scalar::all(255)), idle, keystone,
+                        rig.projectorSize);
+    const cv::Mat bits = sim::rigPattern(rig);
+
+    {
+        test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "test", "--timeout-s", "3"}, dir_ / "test.log");
+        EXPECT_TRUE(showsWithTheCode(*display, targets, bits, rig.delta, 20s))
+            << "no circles on the projector";
+        EXPECT_EQ(tool.wait(20s), 0) << tool.output();
+        EXPECT_THAT(tool.output(), HasSubstr("tap the centre of each circle the projector shows"));
+        EXPECT_THAT(tool.output(), HasSubstr("FRR"));
+    }
+    EXPECT_TRUE(showsWithTheCode(*display, idle, bits, rig.delta, 20s)) << "the display does not come back";
+
+    {
+        test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "test"}, dir_ / "killed.log");
+        EXPECT_TRUE(showsWithTheCode(*display, targets, bits, rig.delta, 20s))
+            << "no circles on the projector";
+        tool.signal(SIGKILL);
+        EXPECT_TRUE(tool.wait(10s));
+    }
+    EXPECT_TRUE(showsWithTheCode(*display, idle, bits, rig.delta, 20s))
+        << "the circles stay after their client died";
+    daemon_->signal(SIGTERM);
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    camera_.reset();
+}
+
 TEST_F(CameraServiceTest, AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration) {
     const test::VirtualDisplay display(cv::Size(320, 240));
     ::setenv("DISPLAY", display.name().c_str(), 1);
@@ -483,6 +613,22 @@ TEST_F(CameraServiceTest, AProjectorWindowOnADisplayThatDoesNotExistIsABadConfig
     EXPECT_EQ(daemon_->wait(kExitTimeout), 2);
     EXPECT_THAT(daemon_->output(), HasSubstr("[Projector] Display=: HDMI-9: no such display on x11; it has 0 "
                                              "\"screen\" (320x240)"));
+}
+
+TEST_F(CameraServiceTest, AnOverlayNeedsAMonitorThatExistsAndACompositingManager) {
+    const test::VirtualDisplay display(cv::Size(320, 240));
+    ::setenv("DISPLAY", display.name().c_str(), 1);
+    startDaemon("PixelFormat=Mono8\n", "[Projector]\nOutput=overlay\n");
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 1);
+    EXPECT_THAT(daemon_->output(),
+                HasSubstr("no compositing manager runs on the X server " + display.name()));
+
+    const test::Compositor compositor(display.name());
+    startDaemon("PixelFormat=Mono8\n", "[Projector]\nOutput=overlay\nDisplay=HDMI-9\n");
+    EXPECT_EQ(daemon_->wait(kExitTimeout), 2);
+    EXPECT_THAT(daemon_->output(),
+                HasSubstr("[Projector] Display=: HDMI-9: no such monitor on the X server " + display.name() +
+                          "; it has 0 \"screen\" (320x240)"));
 }
 
 TEST_F(CameraServiceTest, ASettingTheCameraRefusesIsABadConfiguration) {

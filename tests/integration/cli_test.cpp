@@ -252,7 +252,7 @@ TEST(Everytouchd, NamesItsThreads) {
 }
 
 TEST(Everytouchd, UnknownProjectorOutputIsAUsageErrorNamingTheOption) {
-    for (const char* projector : {"beamer", "external:HDMI-1", "overlay"}) {
+    for (const char* projector : {"beamer", "external:HDMI-1", "overlays"}) {
         const test::ProcessResult result = test::runProcess({EVERYTOUCHD_PATH, "--projector", projector});
         EXPECT_EQ(result.exitCode, 2) << projector;
         EXPECT_THAT(result.err, HasSubstr("--projector: ")) << projector;

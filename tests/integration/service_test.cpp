@@ -1300,7 +1300,9 @@ TEST_F(ServiceTest, TheMonitorShowsEachChangeOfContactsAsTheDaemonTracksThem) {
         // The daemon's rate of arrivals over its recent window: 0 when fewer than two frames arrived in it,
         // as they do now and then on a loaded machine under the sanitizers (4 frames/s).
         EXPECT_GE(line.frameRate, 0.0) << result.out;
-        EXPECT_LE(line.frameRate, 130.0) << "the simulated camera runs at 120 frames/s";
+        // A rig paced in real time catches up after a delay with a burst a little above its rate (130.5
+        // frames/s was seen on a busy machine); frames or pairs counted twice would show 240.
+        EXPECT_LE(line.frameRate, 160.0) << "the simulated camera runs at 120 frames/s";
         highestFrameRate = std::max(highestFrameRate, line.frameRate);
         EXPECT_EQ(line.count, line.contacts.size()) << result.out;
         for (const MonitorContact& contact : line.contacts) {
@@ -1556,14 +1558,14 @@ TEST_F(ServiceTest, TheAccuracyTestScoresTheSimulatedHandsTapsAsTheDaemonDetecte
 }
 
 // A short timeout: were the rig let through, the test would end soon, scored, with status 0.
-TEST_F(ServiceTest, TheAccuracyTestNeedsTheSimulatedRigToShowItsCircles) {
+TEST_F(ServiceTest, TheAccuracyTestCannotRunOnARecording) {
     startDaemon();
     const test::ProcessResult result = test::runProcess({EVERYTOUCH_CALIB_PATH, "test", "--timeout-s", "3"});
     EXPECT_EQ(result.exitCode, 1);
-    EXPECT_THAT(result.err, HasSubstr("everytouchd runs on replay:" + SharedRecording::path().string()));
+    EXPECT_THAT(result.err, HasSubstr("everytouchd replays replay:" + SharedRecording::path().string()));
     EXPECT_THAT(result.err,
-                HasSubstr("shows its circles with the projector, which this build cannot do yet"));
-    EXPECT_THAT(result.err, HasSubstr("run everytouchd --rig sim:grid35"));
+                HasSubstr("which shows what it recorded and taps no circle this test could show"));
+    EXPECT_THAT(result.err, HasSubstr("(everytouchd --rig sim:grid35)"));
     EXPECT_EQ(result.out, "");
 }
 

@@ -111,5 +111,30 @@ TEST(Keystone, FailsWhenTheImageDoesNotLandOnTheTable) {
     EXPECT_THAT(fit.failure().message, HasSubstr("never reaches the table"));
 }
 
+TEST(Keystone, TheDisplayThroughItsFitLandsAsAnUprightRectangle) {
+    Calibration rig = test::paperLikeCalibration();
+    rig.displaySize = {1280, 960};
+    rig.displayToProjector = fitDisplayToTable(rig, rig.displaySize)->displayToProjector;
+    const DisplayShape shape = displayShapeOnTable(rig);
+    EXPECT_NEAR(shape.leastCornerDeg, 90.0, 1e-6);
+    EXPECT_NEAR(shape.largestCornerDeg, 90.0, 1e-6);
+    EXPECT_NEAR(shape.topMm, shape.bottomMm, 1e-6);
+    EXPECT_NEAR(shape.leftMm, shape.rightMm, 1e-6);
+    EXPECT_NEAR(shape.topMm / shape.leftMm, 1280.0 / 960.0, 1e-6);
+}
+
+TEST(Keystone, TheWholePanelOfATiltedProjectorLandsAsNoRectangle) {
+    Calibration rig = test::paperLikeCalibration();
+    rig.tableToProjector =
+        Eigen::AngleAxisd(10 * M_PI / 180, Eigen::Vector3d::UnitX()) * rig.tableToProjector;
+    rig.displaySize = rig.projectorSize;
+    rig.displayToProjector = Eigen::Matrix3d::Identity();
+    const DisplayShape shape = displayShapeOnTable(rig);
+    // The whole panel of a projector tilted further throws one side longer than the one opposite.
+    EXPECT_GT(std::abs(shape.topMm - shape.bottomMm), 0.02 * shape.topMm);
+    EXPECT_LT(shape.leastCornerDeg, 89.0);
+    EXPECT_GT(shape.largestCornerDeg, 91.0);
+}
+
 }  // namespace
 }  // namespace everytouch::core

@@ -17,6 +17,7 @@
 #include "core/projector_chessboard.h"
 #include "io/input_error.h"
 #include "io/recording.h"
+#include "support/screen_grabs.h"
 #include "support/temp_dir.h"
 #include "support/virtual_display.h"
 
@@ -32,36 +33,6 @@ core::ChessboardOptions smallBoard() {
     core::ChessboardOptions options;
     options.squarePx = 30;
     return options;
-}
-
-bool same(const cv::Mat& a, const cv::Mat& b) {
-    return a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) <= 1.0;
-}
-
-// The screen as it shows `positive` and as it shows `negative`, each grabbed from the screen within 10 s;
-// empty when it showed neither in that time. Every grab after the first that matched must be one of the two.
-struct Grabbed {
-    cv::Mat positive, negative;
-    int others = 0;  // grabs after the first match that were neither
-};
-
-Grabbed grabBoth(const test::VirtualDisplay& display, const cv::Mat& positive, const cv::Mat& negative) {
-    Grabbed grabbed;
-    bool matched = false;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
-           std::chrono::steady_clock::now() < deadline) {
-        const cv::Mat screen = display.grab();
-        if (same(screen, positive))
-            grabbed.positive = screen;
-        else if (same(screen, negative))
-            grabbed.negative = screen;
-        else if (matched)
-            ++grabbed.others;
-        matched = matched || !grabbed.positive.empty() || !grabbed.negative.empty();
-        std::this_thread::sleep_for(std::chrono::milliseconds(3));
-    }
-    return grabbed;
 }
 
 class WindowProjectorTest : public ::testing::Test {
@@ -89,7 +60,7 @@ TEST_F(WindowProjectorTest, ShowsAnImageWithTheCodeAddedAndTakenAwayOnAlternateR
     cv::cvtColor(board, boardColour, cv::COLOR_GRAY2BGR);
     core::embedCode(boardColour, window.pattern(), kDelta, positive, negative);
 
-    const Grabbed grabbed = grabBoth(display_, positive, negative);
+    const test::AlternateGrabs grabbed = test::grabAlternates(display_, positive, negative);
     ASSERT_FALSE(grabbed.positive.empty()) << "the screen never showed I = O + P";
     ASSERT_FALSE(grabbed.negative.empty()) << "the screen never showed I' = O - P";
     EXPECT_EQ(grabbed.others, 0);
@@ -128,7 +99,7 @@ TEST_F(WindowProjectorTest, BetweenImagesTheDisplayAreaIsWhiteThroughTheKeystone
     cv::eigen2cv(displayToProjector, keystone);
     cv::warpPerspective(cv::Mat(400, 600, CV_8UC3, cv::Scalar::all(255)), content, keystone, kScreen);
     core::embedCode(content, window.pattern(), kDelta, positive, negative);
-    const Grabbed grabbed = grabBoth(display_, positive, negative);
+    const test::AlternateGrabs grabbed = test::grabAlternates(display_, positive, negative);
     EXPECT_FALSE(grabbed.positive.empty());
     EXPECT_FALSE(grabbed.negative.empty());
     EXPECT_EQ(grabbed.others, 0);

@@ -62,6 +62,9 @@ TEST(Config, ReadsEveryKey) {
     write(dir / "everytouchd.conf", "[Projector]\nOutput=window\nDisplay=HDMI-1\n");
     EXPECT_EQ(loadConfig(dir / "everytouchd.conf", true).projector,
               (ProjectorConfig{ProjectorOutput::Window, 1, 10, "HDMI-1"}));
+    write(dir / "everytouchd.conf", "[Projector]\nOutput=overlay\nDisplay=DP-2\n");
+    EXPECT_EQ(loadConfig(dir / "everytouchd.conf", true).projector,
+              (ProjectorConfig{ProjectorOutput::Overlay, 1, 10, "DP-2"}));
 }
 
 TEST(Config, DropInsOverrideInLexicalOrderAndEmptyRestoresDefault) {
@@ -124,9 +127,7 @@ TEST(Config, BadValuesSayWhatIsAccepted) {
         {"[Camera]\nTrigger=Line 0\n",
          ":2: [Camera] Trigger: expected off or a trigger source such as Line0"},
         {"[Projector]\nOutput=dlp\n",
-         ":2: [Projector] Output: expected none, external or window, found \"dlp\""},
-        {"[Projector]\nOutput=overlay\n",
-         ":2: [Projector] Output: overlay is not part of this build yet; it knows none, external and window"},
+         ":2: [Projector] Output: expected none, external, window or overlay, found \"dlp\""},
         {"[Projector]\nSeed=-1\n", ":2: [Projector] Seed: expected a whole number from 0 to"},
         {"[Projector]\nSeed=18446744073709551616\n", ":2: [Projector] Seed: expected a whole number"},
         {"[Projector]\nDelta=0\n",
