@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -227,9 +228,11 @@ std::optional<core::Frame> AravisSource::read(cv::Mat spare) {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point giveUp = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                         std::chrono::duration<double>(stallTimeoutSeconds()));
-    while (Clock::now() < giveUp) {
-        // A short wait at a time, so that a stalled camera is noticed on time.
-        ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream_.get(), 100'000);
+    for (Clock::time_point now = Clock::now(); now < giveUp; now = Clock::now()) {
+        // A short wait at a time, never beyond the deadline, so that a stalled camera is noticed on time.
+        const auto waitUs = std::chrono::duration_cast<std::chrono::microseconds>(giveUp - now).count();
+        ArvBuffer* buffer = arv_stream_timeout_pop_buffer(
+            stream_.get(), static_cast<guint64>(std::clamp<std::int64_t>(waitUs, 1, 100'000)));
         if (!buffer)
             continue;
         const std::uint64_t frameId = arv_buffer_get_frame_id(buffer);

@@ -23,9 +23,14 @@ public:
 };
 
 // How long a free-running camera at `frameRate` (0: unknown) may deliver no complete frame before it counts
-// as lost: ten frame periods, at least half a second; a second when the rate is unknown.
+// as lost: ten frame periods, kept between 0.3 s (a busy machine's pause is no lost camera, and taking one
+// back costs seconds) and 0.4 s (a pulled cable must release the contacts and show within half a second);
+// at least three periods for a camera slower than that; a second when the rate is unknown.
 inline double cameraStallSeconds(double frameRate) {
-    return frameRate > 0.0 ? std::max(0.5, 10.0 / frameRate) : 1.0;
+    if (!(frameRate > 0.0))
+        return 1.0;
+    const double period = 1.0 / frameRate;
+    return std::max(3.0 * period, std::clamp(10.0 * period, 0.3, 0.4));
 }
 
 // A stream of camera frames: a camera, the simulator or a recording. `next` blocks until the next frame

@@ -5,9 +5,11 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -274,10 +276,11 @@ std::optional<core::Frame> V4l2Source::read(cv::Mat spare) {
     using Clock = std::chrono::steady_clock;
     const Clock::time_point giveUp = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                         std::chrono::duration<double>(stallTimeoutSeconds()));
-    while (Clock::now() < giveUp) {
-        // A short wait at a time, so that a stalled camera is noticed on time.
+    for (Clock::time_point now = Clock::now(); now < giveUp; now = Clock::now()) {
+        // A short wait at a time, never beyond the deadline, so that a stalled camera is noticed on time.
+        const auto waitMs = std::chrono::ceil<std::chrono::milliseconds>(giveUp - now).count();
         pollfd ready{fd_.get(), POLLIN, 0};
-        const int polled = ::poll(&ready, 1, 100);
+        const int polled = ::poll(&ready, 1, static_cast<int>(std::clamp<std::int64_t>(waitMs, 1, 100)));
         if (polled < 0 && errno != EINTR)
             lose(description_ + ": " + std::strerror(errno));
         if (polled <= 0)

@@ -179,7 +179,7 @@ TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARe
     camera_->unplug();
     ASSERT_TRUE(
         waitForStatus("STATUS=Camera lost, asking it again: camera Aravis Fake (serial everytouch-test), "
-                      "320x240 Mono8 at 60 frames/s: no complete frame for 0.5 s"))
+                      "320x240 Mono8 at 60 frames/s: no complete frame for 0.3 s"))
         << "the status does not say the camera is lost";
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
     EXPECT_THAT(get("StateReason"), ::testing::StartsWith("s \"camera lost, asking it again: "));
