@@ -1,25 +1,40 @@
 #include "io/output_thread.h"
 
+#include <stdexcept>
 #include <utility>
 
+#include "io/log.h"
 #include "io/thread_name.h"
 
 namespace everytouch::io {
 
-OpenedOutput startOutputThread(std::thread& thread, const char* name,
-                               std::function<void(std::promise<OpenedOutput>&)> body) {
+OpenedOutput OutputThread::start(const char* name, std::function<void(std::promise<OpenedOutput>&)> body) {
+    if (thread_.joinable())
+        throw std::logic_error("an output's thread is started once");
     std::promise<OpenedOutput> opened;
     std::future<OpenedOutput> result = opened.get_future();
-    thread = std::thread([name, &opened, body = std::move(body)] {
+    thread_ = std::thread([name, &opened, body = std::move(body)] {
         nameThisThread(name);
         body(opened);
     });
     try {
-        return result.get();
+        OpenedOutput output = result.get();
+        description_ = output.description;
+        return output;
     } catch (...) {
-        thread.join();
+        thread_.join();
         throw;
     }
+}
+
+OutputThread::~OutputThread() {
+    stopping_ = true;
+    if (!thread_.joinable())
+        return;
+    thread_.join();
+    if (missed_ > 0)
+        ET_LOG(Notice) << description_ << ": " << missed_ << " of " << presented_ + missed_
+                       << " refreshes passed without a new image";
 }
 
 }  // namespace everytouch::io

@@ -250,28 +250,15 @@ OverlayProjector::OverlayProjector(const std::string& display, std::uint64_t see
                                    const std::filesystem::path& patternDirectory)
     : delta_(delta) {
     checkCodeDelta(delta);
-    OpenedOutput opened =
-        startOutputThread(thread_, "et-overlay",
-                          [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
+    OpenedOutput opened = thread_.start(
+        "et-overlay", [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
     size_ = opened.size;
     description_ = std::move(opened.description);
-    try {
-        pattern_ = keptPattern(seed, size_, patternDirectory);
-        handOverCodeOverlay();
-    } catch (...) {
-        stopping_ = true;
-        thread_.join();
-        throw;
-    }
+    pattern_ = keptPattern(seed, size_, patternDirectory);
+    handOverCodeOverlay();
 }
 
-OverlayProjector::~OverlayProjector() {
-    stopping_ = true;
-    thread_.join();
-    if (missed_ > 0)
-        ET_LOG(Notice) << description_ << ": " << missed_ << " of " << presented_ + missed_
-                       << " refreshes passed without a new image";
-}
+OverlayProjector::~OverlayProjector() = default;
 
 void OverlayProjector::setDisplayToProjector(cv::Size displaySize,
                                              const Eigen::Matrix3d& displayToProjector) {
@@ -347,7 +334,7 @@ void OverlayProjector::run(const std::string& display, std::promise<OpenedOutput
     std::uint32_t inFlight = 0;  // the serial of the image being presented; 0: none
     std::uint64_t lastMsc = 0;   // the refresh counter when the last image went up; 0: none yet
     int polarity = 0;
-    while (!stopping_) {
+    while (!thread_.stopping()) {
         {
             const std::lock_guard lock(handOverMutex_);
             if (fresh_) {
@@ -407,10 +394,10 @@ void OverlayProjector::run(const std::string& display, std::promise<OpenedOutput
                         static_cast<const XPresentCompleteNotifyEvent*>(event.xcookie.data);
                     if (inFlight != 0 && complete->serial_number == inFlight) {
                         if (lastMsc != 0 && complete->msc > lastMsc + 1)
-                            missed_ += complete->msc - lastMsc - 1;
+                            thread_.countMissed(complete->msc - lastMsc - 1);
                         lastMsc = complete->msc;
                         inFlight = 0;
-                        ++presented_;
+                        thread_.countPresented();
                         polarity ^= 1;
                     }
                 }

@@ -6,7 +6,6 @@
 #include <future>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "io/output_thread.h"
 #include "io/projector_output.h"
@@ -51,7 +50,7 @@ public:
     // The code: 0 or 1 per projector pixel (CV_8UC1, size()).
     const cv::Mat& pattern() const { return pattern_; }
     // Refreshes that showed one of the two images so far, and whether the overlay is up.
-    std::uint64_t presented() const { return presented_; }
+    std::uint64_t presented() const { return thread_.presented(); }
     bool visible() const { return visible_; }
 
 private:
@@ -69,16 +68,11 @@ private:
     cv::Mat handedOver_[2];  // the next two images (premultiplied BGRA), taken by the overlay's thread
     bool fresh_ = false;
 
-    std::atomic<bool> stopping_{false};
     std::atomic<bool> visible_{false};
     std::atomic<bool> compositorGone_{false};  // the overlay hides meanwhile
     std::mutex problemMutex_;
     std::function<void()> problemHandler_;
-    // Refreshes presented, and refreshes that passed without a new image (each swaps the polarity the camera
-    // sees): said when the overlay closes.
-    std::atomic<std::uint64_t> presented_{0};
-    std::atomic<std::uint64_t> missed_{0};
-    std::thread thread_;
+    OutputThread thread_;  // last: it stops before what it draws from goes away
 };
 
 }  // namespace everytouch::io

@@ -96,28 +96,15 @@ WindowProjector::WindowProjector(const std::string& display, std::uint64_t seed,
                                  const std::filesystem::path& patternDirectory)
     : delta_(delta) {
     checkCodeDelta(delta);
-    OpenedOutput opened =
-        startOutputThread(thread_, "et-projector",
-                          [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
+    OpenedOutput opened = thread_.start(
+        "et-projector", [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
     size_ = opened.size;
     description_ = std::move(opened.description);
-    try {
-        pattern_ = keptPattern(seed, size_, patternDirectory);
-        embedAndHandOver(idleImage());
-    } catch (...) {
-        stopping_ = true;
-        thread_.join();
-        throw;
-    }
+    pattern_ = keptPattern(seed, size_, patternDirectory);
+    embedAndHandOver(idleImage());
 }
 
-WindowProjector::~WindowProjector() {
-    stopping_ = true;
-    thread_.join();
-    if (missed_ > 0)
-        ET_LOG(Notice) << description_ << ": " << missed_ << " of " << presented_ + missed_
-                       << " refreshes passed without a new image";
-}
+WindowProjector::~WindowProjector() = default;
 
 void WindowProjector::setDisplayToProjector(cv::Size displaySize, const Eigen::Matrix3d& displayToProjector) {
     core::checkDisplayToProjector(displaySize, displayToProjector);
@@ -214,7 +201,7 @@ void WindowProjector::run(const std::string& display, std::promise<OpenedOutput>
     int polarity = 0;
     Clock::time_point last = Clock::now();
     bool reported = false;
-    while (!stopping_) {
+    while (!thread_.stopping()) {
         SDL_Event event;
         while (SDL_PollEvent(&event)) {
         }
@@ -244,7 +231,7 @@ void WindowProjector::run(const std::string& display, std::promise<OpenedOutput>
             reported = true;
         }
         SDL_RenderPresent(renderer.get());
-        ++presented_;
+        thread_.countPresented();
         polarity ^= 1;
 
         // With vertical sync the present returns at the next refresh; without it (a virtual display server),
@@ -256,8 +243,8 @@ void WindowProjector::run(const std::string& display, std::promise<OpenedOutput>
         }
         const double periods =
             std::chrono::duration<double>(now - last) / std::chrono::duration<double>(period);
-        if (presented_ > 1 && periods > 1.5)
-            missed_ += static_cast<std::uint64_t>(std::lround(periods)) - 1;
+        if (thread_.presented() > 1 && periods > 1.5)
+            thread_.countMissed(static_cast<std::uint64_t>(std::lround(periods)) - 1);
         last = now;
     }
 }

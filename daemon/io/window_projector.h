@@ -1,12 +1,10 @@
 #pragma once
 
-#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <future>
 #include <mutex>
 #include <string>
-#include <thread>
 
 #include "io/output_thread.h"
 #include "io/projector_output.h"
@@ -62,12 +60,7 @@ private:
     cv::Mat handedOver_[2];  // the next I and I', taken by the window's thread
     bool fresh_ = false;
 
-    std::atomic<bool> stopping_{false};
-    // Refreshes presented, and refreshes that passed without a new image (each swaps the polarity the camera
-    // sees; the camera's side re-locks on the code's sign): said when the window closes.
-    std::atomic<std::uint64_t> presented_{0};
-    std::atomic<std::uint64_t> missed_{0};
-    std::thread thread_;
+    OutputThread thread_;  // last: it stops before what it draws from goes away
 };
 
 }  // namespace everytouch::io

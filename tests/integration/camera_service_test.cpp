@@ -53,6 +53,36 @@ using ::testing::HasSubstr;
 constexpr auto kStartTimeout = 60s;
 constexpr auto kExitTimeout = 30s;
 
+// The content the window shows now (O, compressed to [delta, 255 - delta]): the mean of two screens of
+// opposite polarity, grabbed as soon as the window has presented the other one.
+cv::Mat windowContent(const test::VirtualDisplay& display) {
+    const cv::Mat first = display.grab();
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        const cv::Mat second = display.grab();
+        if (cv::norm(first, second, cv::NORM_INF) > 0.0) {
+            cv::Mat content;
+            cv::addWeighted(first, 0.5, second, 0.5, 0.0, content);
+            return content;
+        }
+        std::this_thread::sleep_for(1ms);
+    }
+    return first;
+}
+
+// A GigE Vision camera whose frames the simulated rig renders, its projector showing what the screen shows.
+std::unique_ptr<test::FakeGigeCamera> filmingTheScreen(const sim::SimParameters& rig,
+                                                       std::shared_ptr<sim::Simulator> simulator,
+                                                       std::shared_ptr<test::VirtualDisplay> display) {
+    return std::make_unique<test::FakeGigeCamera>(
+        rig.cameraSize, [simulator, display](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
+            simulator->projectImage(windowContent(*display));
+            core::Frame frame;
+            sim::FrameTruth truth;
+            simulator->render(frameId, frame, truth);
+            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
+        });
+}
+
 class CameraServiceTest : public ::testing::Test {
 protected:
     static constexpr int kRememberedFrames = 120;
@@ -116,6 +146,43 @@ protected:
         return test::runProcess(test::property("get-property", name)).out;
     }
 
+    // Waits until the daemon's property `name`, as busctl prints it, contains `text`.
+    bool waitForProperty(const std::string& name, const std::string& text) {
+        const auto deadline = std::chrono::steady_clock::now() + 20s;
+        while (std::chrono::steady_clock::now() < deadline) {
+            if (get(name).find(text) != std::string::npos)
+                return true;
+            std::this_thread::sleep_for(50ms);
+        }
+        return false;
+    }
+
+    // Replaces the camera by one filming the screen: a display of the test's own (DISPLAY) whose content
+    // the simulated rig of the table-setup scenario projects onto its table.
+    void filmTheScreen() {
+        rig_.scenario = "table-setup";
+        simulator_ = std::make_shared<sim::Simulator>(rig_, sim::rigPattern(rig_));
+        display_ = std::make_shared<test::VirtualDisplay>(rig_.projectorSize);
+        ::setenv("DISPLAY", display_->name().c_str(), 1);
+        ::unsetenv("WAYLAND_DISPLAY");
+        camera_.reset();
+        camera_ = filmingTheScreen(rig_, simulator_, display_);
+    }
+
+    // Starts everytouchd on the camera filming the screen, its projector `output` (window or overlay) on
+    // that screen with the rig's code; whether it got ready.
+    [[nodiscard]] bool startProjecting(const std::string& output) {
+        startDaemon("PixelFormat=RGB8\nFrameRate=20\n", "[Projector]\nOutput=" + output +
+                                                            "\nSeed=" + std::to_string(rig_.seed) +
+                                                            "\nDelta=" + std::to_string(rig_.delta) + "\n");
+        return notify_->waitFor("READY=1", kStartTimeout);
+    }
+
+    void stopDaemon() {
+        daemon_->signal(SIGTERM);
+        EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    }
+
     // Whether a `camera` snapshot shows a frame the camera sent lately.
     bool snapshotShowsTheCamera() {
         const std::filesystem::path file = dir_ / "camera.png";
@@ -140,6 +207,9 @@ protected:
     test::PrivateBus bus_;
     std::mutex mutex_;
     std::deque<cv::Mat> sent_;
+    sim::SimParameters rig_;  // filmed by filmTheScreen()
+    std::shared_ptr<sim::Simulator> simulator_;
+    std::shared_ptr<test::VirtualDisplay> display_;
     std::unique_ptr<test::FakeGigeCamera> camera_;
     std::unique_ptr<test::NotifySocket> notify_;
     std::unique_ptr<test::BackgroundProcess> daemon_;
@@ -169,8 +239,7 @@ TEST_F(CameraServiceTest, StreamsTheCameraAndSaysItIsNotCalibratedYet) {
     EXPECT_THAT(status.out,
                 HasSubstr("Why:                not calibrated (run everytouch-calib calibrate)\n"));
 
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    stopDaemon();
 }
 
 TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARestart) {
@@ -188,8 +257,7 @@ TEST_F(CameraServiceTest, ACameraThatGoesAwayIsAskedAgainUntilItIsBackWithoutARe
     EXPECT_TRUE(daemon_->running());
     EXPECT_TRUE(snapshotShowsTheCamera()) << "the snapshot is no frame the camera sent after it came back";
     EXPECT_EQ(get("StateReason"), "s \"not calibrated (run everytouch-calib calibrate)\"\n");
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    stopDaemon();
 }
 
 TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeedWrittenBesideTheCalibration) {
@@ -224,8 +292,7 @@ TEST_F(CameraServiceTest, AProjectorThatEmbedsTheCodeItselfGivesTheCodeOfItsSeed
     const cv::Mat written = cv::imread((dir_ / "pattern.png").string(), cv::IMREAD_UNCHANGED);
     ASSERT_EQ(written.type(), CV_8UC1) << "no pattern.png beside the calibration";
     EXPECT_EQ(cv::norm(written, core::generatePattern(pattern) * 255, cv::NORM_INF), 0.0);
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    stopDaemon();
 }
 
 // The first touch-down of a touch log (JSON Lines): frame index and position in display pixels.
@@ -326,8 +393,7 @@ TEST_F(CameraServiceTest, DetectsTheSimulatedRigsTapThroughGigEVision) {
     ASSERT_TRUE(last.contains("contacts")) << last.dump();
     EXPECT_TRUE(last["contacts"].empty())
         << "a contact stays down after the camera was lost: " << last.dump();
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
+    stopDaemon();
 
     // Where the simulated rig's own pipeline puts it, over the same pairs.
     const test::ProcessResult simulated =
@@ -425,38 +491,7 @@ TEST_F(CameraServiceTest, ItsProjectorWindowShowsTheCodeAndTheCalibrationsChessb
     EXPECT_TRUE(showsWithTheCode(display, idle, bits, 12, 20s))
         << "the window does not show the display again";
 
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
-}
-
-// The content the window shows now (O, compressed to [delta, 255 - delta]): the mean of two screens of
-// opposite polarity, grabbed as soon as the window has presented the other one.
-cv::Mat windowContent(const test::VirtualDisplay& display) {
-    const cv::Mat first = display.grab();
-    for (int attempt = 0; attempt < 100; ++attempt) {
-        const cv::Mat second = display.grab();
-        if (cv::norm(first, second, cv::NORM_INF) > 0.0) {
-            cv::Mat content;
-            cv::addWeighted(first, 0.5, second, 0.5, 0.0, content);
-            return content;
-        }
-        std::this_thread::sleep_for(1ms);
-    }
-    return first;
-}
-
-// A GigE Vision camera whose frames the simulated rig renders, its projector showing what the screen shows.
-std::unique_ptr<test::FakeGigeCamera> filmingTheScreen(const sim::SimParameters& rig,
-                                                       std::shared_ptr<sim::Simulator> simulator,
-                                                       std::shared_ptr<test::VirtualDisplay> display) {
-    return std::make_unique<test::FakeGigeCamera>(
-        rig.cameraSize, [simulator, display](std::uint64_t frameId, ArvPixelFormat, cv::Mat& image) {
-            simulator->projectImage(windowContent(*display));
-            core::Frame frame;
-            sim::FrameTruth truth;
-            simulator->render(frameId, frame, truth);
-            cv::cvtColor(frame.image, image, cv::COLOR_BGR2RGB);
-        });
+    stopDaemon();
 }
 
 // The whole loop of a camera rig: everytouchd shows the table step's chessboard in its projector window (an
@@ -464,60 +499,36 @@ std::unique_ptr<test::FakeGigeCamera> filmingTheScreen(const sim::SimParameters&
 // lies, and its camera films it as a GigE Vision camera; the daemon finds the table's pose from those frames.
 // The simulated projector embeds the code anew (of the same seed) into what it takes from the screen.
 TEST_F(CameraServiceTest, CalibratesTheTableThroughItsProjectorWindow) {
-    sim::SimParameters rig;
-    rig.scenario = "table-setup";
-    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
-    const core::Calibration truth = simulator->calibration();
+    filmTheScreen();
+    const core::Calibration truth = simulator_->calibration();
     const core::Calibration moved = test::withTheTableMoved(truth);
     io::writeCalibrationFile(dir_ / "calibration.yml", moved);
-    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
-    ::setenv("DISPLAY", display->name().c_str(), 1);
-    ::unsetenv("WAYLAND_DISPLAY");
-
-    camera_.reset();
-    camera_ = filmingTheScreen(rig, simulator, display);
-    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
-                "[Projector]\nOutput=window\nSeed=" + std::to_string(rig.seed) +
-                    "\nDelta=" + std::to_string(rig.delta) + "\n");
-    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    ASSERT_TRUE(startProjecting("window")) << "everytouchd did not get ready";
 
     test::expectTheTableFound(test::runProcess({EVERYTOUCH_CALIB_PATH, "calibrate", "table"}),
                               dir_ / "calibration.yml", moved, truth);
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
-    camera_.reset();
+    stopDaemon();
 }
 
 // The same loop through the code overlay over a desktop (picom composites it on the test's Xvfb): the table
 // step's chessboard shows opaque in the overlay, and since the desktop under the overlay is not warped, the
 // calibration maps the display onto the whole output.
 TEST_F(CameraServiceTest, CalibratesTheTableThroughItsOverlayAndMapsTheDisplayOntoTheWholeOutput) {
-    sim::SimParameters rig;
-    rig.scenario = "table-setup";
-    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
-    const core::Calibration truth = simulator->calibration();
+    filmTheScreen();
+    const core::Calibration truth = simulator_->calibration();
     const core::Calibration moved = test::withTheTableMoved(truth);
     io::writeCalibrationFile(dir_ / "calibration.yml", moved);
-    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
-    ::setenv("DISPLAY", display->name().c_str(), 1);
-    ::unsetenv("WAYLAND_DISPLAY");
-    const cv::Mat picture(rig.projectorSize, CV_8UC3, cv::Scalar(200, 180, 160));
-    test::DesktopWindow desktop(display->name(), cv::Rect(cv::Point(), rig.projectorSize), picture);
-    test::Compositor compositor(display->name());
-
-    camera_.reset();
-    camera_ = filmingTheScreen(rig, simulator, display);
-    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
-                "[Projector]\nOutput=overlay\nSeed=" + std::to_string(rig.seed) +
-                    "\nDelta=" + std::to_string(rig.delta) + "\n");
-    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
-    EXPECT_THAT(get("Projector"), HasSubstr("the overlay on the X server " + display->name() +
+    const cv::Mat picture(rig_.projectorSize, CV_8UC3, cv::Scalar(200, 180, 160));
+    test::DesktopWindow desktop(display_->name(), cv::Rect(cv::Point(), rig_.projectorSize), picture);
+    test::Compositor compositor(display_->name());
+    ASSERT_TRUE(startProjecting("overlay")) << "everytouchd did not get ready";
+    EXPECT_THAT(get("Projector"), HasSubstr("the overlay on the X server " + display_->name() +
                                             " monitor 0 \\\"screen\\\" (640x480)"));
     // Between calibrations the desktop shows through, the code over it.
     cv::Mat positive, negative;
-    core::makeCodeOverlay(sim::rigPattern(rig), rig.delta, positive, negative);
+    core::makeCodeOverlay(sim::rigPattern(rig_), rig_.delta, positive, negative);
     const test::AlternateGrabs grabbed = test::grabAlternates(
-        *display, test::compositedOver(positive, picture), test::compositedOver(negative, picture));
+        *display_, test::compositedOver(positive, picture), test::compositedOver(negative, picture));
     EXPECT_FALSE(grabbed.positive.empty() || grabbed.negative.empty())
         << "the screen does not show the desktop with the code over it";
 
@@ -526,84 +537,58 @@ TEST_F(CameraServiceTest, CalibratesTheTableThroughItsOverlayAndMapsTheDisplayOn
     // The projector's own keystone must square the display: the user is told how far it is.
     EXPECT_THAT(calibrate.out, HasSubstr("\nThe display lands on the table with sides of "));
     const core::Calibration calibrated = io::readCalibrationFile(dir_ / "calibration.yml");
-    EXPECT_EQ(calibrated.displaySize, rig.projectorSize);
+    EXPECT_EQ(calibrated.displaySize, rig_.projectorSize);
     EXPECT_TRUE(calibrated.displayToProjector.isApprox(Eigen::Matrix3d::Identity()))
         << calibrated.displayToProjector;
 
     // Without a compositing manager the overlay hides, and the state says why nothing is detected.
-    const auto reasonSays = [this](const std::string& text) {
-        const auto deadline = std::chrono::steady_clock::now() + 10s;
-        while (std::chrono::steady_clock::now() < deadline) {
-            if (get("StateReason").find(text) != std::string::npos)
-                return true;
-            std::this_thread::sleep_for(50ms);
-        }
-        return false;
-    };
     compositor.stop();
-    EXPECT_TRUE(reasonSays("not detecting: no compositing manager runs on its X server"))
+    EXPECT_TRUE(waitForProperty("StateReason", "not detecting: no compositing manager runs on its X server"))
         << get("StateReason");
     EXPECT_EQ(get("State"), "s \"degraded\"\n");
-    const test::Compositor again(display->name());
-    EXPECT_TRUE(reasonSays("\"\"")) << "the state stays degraded once a compositing manager runs again: "
-                                    << get("StateReason");
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
-    camera_.reset();
+    const test::Compositor again(display_->name());
+    EXPECT_TRUE(waitForProperty("StateReason", "\"\""))
+        << "the state stays degraded once a compositing manager runs again: " << get("StateReason");
+    stopDaemon();
 }
 
 // everytouch-calib test on a camera rig: the daemon's projector window shows the 35 circles over the display,
 // with the code, while the test runs, and the display again when it ends or its client dies.
 TEST_F(CameraServiceTest, TheAccuracyTestsCirclesShowInTheProjectorWindowWhileItsClientRuns) {
-    sim::SimParameters rig;
-    rig.scenario = "table-setup";
-    auto simulator = std::make_shared<sim::Simulator>(rig, sim::rigPattern(rig));
-    const core::Calibration truth = simulator->calibration();
+    filmTheScreen();
+    const core::Calibration truth = simulator_->calibration();
     io::writeCalibrationFile(dir_ / "calibration.yml", truth);
-    auto display = std::make_shared<test::VirtualDisplay>(rig.projectorSize);
-    ::setenv("DISPLAY", display->name().c_str(), 1);
-    ::unsetenv("WAYLAND_DISPLAY");
-    camera_.reset();
-    camera_ = filmingTheScreen(rig, simulator, display);
-    startDaemon("PixelFormat=RGB8\nFrameRate=20\n",
-                "[Projector]\nOutput=window\nSeed=" + std::to_string(rig.seed) +
-                    "\nDelta=" + std::to_string(rig.delta) + "\n");
-    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
-    const auto deadline = std::chrono::steady_clock::now() + 20s;
-    while (get("State") != "s \"running\"\n" && std::chrono::steady_clock::now() < deadline)
-        std::this_thread::sleep_for(100ms);
-    ASSERT_EQ(get("State"), "s \"running\"\n") << get("StateReason");
+    ASSERT_TRUE(startProjecting("window")) << "everytouchd did not get ready";
+    ASSERT_TRUE(waitForProperty("State", "\"running\"")) << get("StateReason");
 
     cv::Mat keystone;
     cv::eigen2cv(truth.displayToProjector, keystone);
     cv::Mat targets, idle;
-    cv::warpPerspective(core::drawAccuracyTargets(truth.displaySize), targets, keystone, rig.projectorSize);
+    cv::warpPerspective(core::drawAccuracyTargets(truth.displaySize), targets, keystone, rig_.projectorSize);
     cv::warpPerspective(cv::Mat(truth.displaySize, CV_8UC3, cv::Scalar::all(255)), idle, keystone,
-                        rig.projectorSize);
-    const cv::Mat bits = sim::rigPattern(rig);
+                        rig_.projectorSize);
+    const cv::Mat bits = sim::rigPattern(rig_);
 
     {
         test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "test", "--timeout-s", "3"}, dir_ / "test.log");
-        EXPECT_TRUE(showsWithTheCode(*display, targets, bits, rig.delta, 20s))
+        EXPECT_TRUE(showsWithTheCode(*display_, targets, bits, rig_.delta, 20s))
             << "no circles on the projector";
         EXPECT_EQ(tool.wait(20s), 0) << tool.output();
         EXPECT_THAT(tool.output(), HasSubstr("tap the centre of each circle the projector shows"));
         EXPECT_THAT(tool.output(), HasSubstr("FRR"));
     }
-    EXPECT_TRUE(showsWithTheCode(*display, idle, bits, rig.delta, 20s)) << "the display does not come back";
+    EXPECT_TRUE(showsWithTheCode(*display_, idle, bits, rig_.delta, 20s)) << "the display does not come back";
 
     {
         test::BackgroundProcess tool({EVERYTOUCH_CALIB_PATH, "test"}, dir_ / "killed.log");
-        EXPECT_TRUE(showsWithTheCode(*display, targets, bits, rig.delta, 20s))
+        EXPECT_TRUE(showsWithTheCode(*display_, targets, bits, rig_.delta, 20s))
             << "no circles on the projector";
         tool.signal(SIGKILL);
         EXPECT_TRUE(tool.wait(10s));
     }
-    EXPECT_TRUE(showsWithTheCode(*display, idle, bits, rig.delta, 20s))
+    EXPECT_TRUE(showsWithTheCode(*display_, idle, bits, rig_.delta, 20s))
         << "the circles stay after their client died";
-    daemon_->signal(SIGTERM);
-    EXPECT_EQ(daemon_->wait(kExitTimeout), 0) << "everytouchd did not stop cleanly on SIGTERM";
-    camera_.reset();
+    stopDaemon();
 }
 
 TEST_F(CameraServiceTest, AProjectorWindowOnADisplayThatDoesNotExistIsABadConfiguration) {
