@@ -8,15 +8,10 @@
 #include <utility>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
-
-#include "core/code_overlay.h"
-#include "core/embedding.h"
-#include "core/keystone.h"
 #include "io/input_error.h"
-#include "io/kept_pattern.h"
 #include "io/log.h"
 #include "io/output_thread.h"
+#include "io/overlay_images.h"
 #include "io/projector_image.h"
 
 // Xlib's macros (None, Status, Bool) would clash with the C++ headers above: it comes last, and this file
@@ -98,12 +93,6 @@ bool compositorRuns(Display* display, Atom selection) {
     return XGetSelectionOwner(display, selection) != None;
 }
 
-cv::Mat opaque(const cv::Mat& bgr) {
-    cv::Mat bgra;
-    cv::cvtColor(bgr, bgra, cv::COLOR_BGR2BGRA);
-    return bgra;
-}
-
 }  // namespace
 
 // The overlay's X resources. Closing the connection frees every resource it made on the server.
@@ -117,8 +106,8 @@ public:
         if (!display_)
             throw std::runtime_error(
                 server_.empty()
-                    ? std::string("the code overlay needs an X server, and DISPLAY is not set (on "
-                                  "Wayland, use [Projector] Output=window)")
+                    ? std::string("the code overlay needs a Wayland compositor or an X server, and neither "
+                                  "WAYLAND_DISPLAY nor DISPLAY is set")
                     : "the code overlay cannot connect to the X server " + server_);
         Display* x = display_.get();
         int eventBase = 0, errorBase = 0;
@@ -247,72 +236,20 @@ private:
 };
 
 OverlayProjector::OverlayProjector(const std::string& display, std::uint64_t seed, int delta,
-                                   const std::filesystem::path& patternDirectory)
-    : delta_(delta) {
+                                   const std::filesystem::path& patternDirectory) {
     checkCodeDelta(delta);
-    OpenedOutput opened = thread_.start(
-        "et-overlay", [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); });
-    size_ = opened.size;
-    description_ = std::move(opened.description);
-    pattern_ = keptPattern(seed, size_, patternDirectory);
-    handOverCodeOverlay();
+    takeOutput(thread_.start("et-overlay",
+                             [this, display](std::promise<OpenedOutput>& promise) { run(display, promise); }),
+               seed, delta, patternDirectory);
 }
 
 OverlayProjector::~OverlayProjector() = default;
 
-void OverlayProjector::setDisplayToProjector(cv::Size displaySize,
-                                             const Eigen::Matrix3d& displayToProjector) {
-    core::checkDisplayToProjector(displaySize, displayToProjector);
-    const Eigen::Matrix3d normalised = displayToProjector / displayToProjector(2, 2);
-    Eigen::Matrix3d scale = Eigen::Matrix3d::Identity();
-    scale(0, 0) = static_cast<double>(size_.width) / displaySize.width;
-    scale(1, 1) = static_cast<double>(size_.height) / displaySize.height;
-    if (!normalised.isApprox(scale, 1e-6))
-        ET_LOG(Warning)
-            << description_
-            << ": the calibration draws the display through a keystone, and the desktop under the "
-               "overlay is not warped: touches land off their places until the table is calibrated "
-               "through the overlay (everytouch-calib calibrate table)";
-}
-
-void OverlayProjector::show(const cv::Mat& projectorImage) {
-    cv::Mat positive, negative;
-    core::embedCode(projectorImageInColour(projectorImage, size_), pattern_, delta_, positive, negative);
-    handOver(opaque(positive), opaque(negative));
-}
-
-void OverlayProjector::release() noexcept {
-    try {
-        handOverCodeOverlay();
-    } catch (const std::exception& error) {
-        ET_LOG(Error) << description_
-                      << ": the code over the desktop could not be drawn again: " << error.what();
-    }
-}
-
 std::optional<std::string> OverlayProjector::problem() const {
     if (compositorGone_)
         return "no compositing manager runs on its X server, so the code overlay hides until one does (" +
-               description_ + ")";
+               describe() + ")";
     return std::nullopt;
-}
-
-void OverlayProjector::onProblemChange(std::function<void()> handler) {
-    const std::lock_guard lock(problemMutex_);
-    problemHandler_ = std::move(handler);
-}
-
-void OverlayProjector::handOverCodeOverlay() {
-    cv::Mat positive, negative;
-    core::makeCodeOverlay(pattern_, delta_, positive, negative);
-    handOver(std::move(positive), std::move(negative));
-}
-
-void OverlayProjector::handOver(cv::Mat positive, cv::Mat negative) {
-    const std::lock_guard lock(handOverMutex_);
-    handedOver_[0] = std::move(positive);
-    handedOver_[1] = std::move(negative);
-    fresh_ = true;
 }
 
 void OverlayProjector::run(const std::string& display, std::promise<OpenedOutput>& opened) {
@@ -335,15 +272,9 @@ void OverlayProjector::run(const std::string& display, std::promise<OpenedOutput
     std::uint64_t lastMsc = 0;   // the refresh counter when the last image went up; 0: none yet
     int polarity = 0;
     while (!thread_.stopping()) {
-        {
-            const std::lock_guard lock(handOverMutex_);
-            if (fresh_) {
-                std::swap(images[0], handedOver_[0]);
-                std::swap(images[1], handedOver_[1]);
-                fresh_ = false;
-                connection->upload(images);
-                haveImages = true;
-            }
+        if (images_.takeNewest(images)) {
+            connection->upload(images);
+            haveImages = true;
         }
         if (haveImages && compositor && !mapped) {
             connection->map();
@@ -378,9 +309,7 @@ void OverlayProjector::run(const std::string& display, std::promise<OpenedOutput
                            "runs again, and touches are not detected meanwhile";
                 if (runs != compositor) {
                     compositorGone_ = !runs;
-                    const std::lock_guard lock(problemMutex_);
-                    if (problemHandler_)
-                        problemHandler_();
+                    problemChanged();
                 }
                 compositor = runs;
             } else if (event.type == MapNotify || event.type == ConfigureNotify) {

@@ -1,5 +1,7 @@
 #include "service/frame_sources.h"
 
+#include <cstdlib>
+
 #include "io/aravis_source.h"
 #include "io/input_error.h"
 #include "io/overlay_projector.h"
@@ -7,6 +9,7 @@
 #include "io/sim_projector.h"
 #include "io/sim_source.h"
 #include "io/v4l2_source.h"
+#include "io/wayland_overlay_projector.h"
 #include "io/window_projector.h"
 
 namespace everytouch::service {
@@ -16,6 +19,16 @@ namespace {
 void openCameraProjector(const ProjectorConfig& projector, const std::filesystem::path& stateDirectory,
                          OpenedRig& rig) {
     if (projector.output == ProjectorOutput::Overlay) {
+        // A Wayland session's X server (Xwayland) draws its windows through the Wayland compositor, so
+        // the compositor's own overlay layer is taken wherever there is one.
+        const char* wayland = std::getenv("WAYLAND_DISPLAY");
+        if (wayland && *wayland) {
+            auto overlay = std::make_unique<io::WaylandOverlayProjector>(projector.display, projector.seed,
+                                                                         projector.delta, stateDirectory);
+            rig.pattern = overlay->pattern();
+            rig.projector = std::move(overlay);
+            return;
+        }
         auto overlay = std::make_unique<io::OverlayProjector>(projector.display, projector.seed,
                                                               projector.delta, stateDirectory);
         rig.pattern = overlay->pattern();

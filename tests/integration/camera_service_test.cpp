@@ -42,6 +42,8 @@
 #include "support/screen_grabs.h"
 #include "support/temp_dir.h"
 #include "support/virtual_display.h"
+#include "support/wait.h"
+#include "support/wayland_compositor.h"
 
 namespace everytouch {
 namespace {
@@ -105,6 +107,7 @@ protected:
     }
 
     void TearDown() override {
+        ::unsetenv("WAYLAND_DISPLAY");
         if (daemon_ && HasFailure())
             std::cerr << "---- everytouchd log ----\n" << daemon_->output() << "-------------------------\n";
     }
@@ -588,6 +591,44 @@ TEST_F(CameraServiceTest, TheAccuracyTestsCirclesShowInTheProjectorWindowWhileIt
     }
     EXPECT_TRUE(showsWithTheCode(*display_, idle, bits, rig_.delta, 20s))
         << "the circles stay after their client died";
+    stopDaemon();
+}
+
+// On a Wayland desktop (sway here) the overlay is a surface on the compositor's overlay layer; the state says
+// when the compositor goes away, and the code comes back with it.
+TEST_F(CameraServiceTest, OnAWaylandDesktopTheOverlayIsOnTheCompositorsOverlayLayer) {
+    const cv::Size output(320, 240);
+    const cv::Vec3b colour(160, 180, 200);
+    sim::SimParameters rig;
+    rig.cameraSize = cv::Size(320, 240);
+    rig.projectorSize = output;
+    io::writeCalibrationFile(dir_ / "calibration.yml", sim::rigCalibration(rig));
+    test::WaylandCompositor compositor(output, colour);
+    ::setenv("WAYLAND_DISPLAY", compositor.socket().c_str(), 1);
+    startDaemon("PixelFormat=Mono8\nFrameRate=30\n",
+                "[Projector]\nOutput=overlay\nDisplay=HEADLESS-1\nSeed=5\nDelta=10\n");
+    ASSERT_TRUE(notify_->waitFor("READY=1", kStartTimeout)) << "everytouchd did not get ready";
+    EXPECT_THAT(get("Projector"), HasSubstr("the overlay on the Wayland compositor " + compositor.socket() +
+                                            " output 0 \\\"HEADLESS-1\\\" (320x240)"));
+    core::PatternOptions pattern;
+    pattern.size = output;
+    pattern.seed = 5;
+    const cv::Mat bits = core::generatePattern(pattern);
+    const auto grab = [&compositor] { return compositor.grab(); };
+    test::AlternateGrabs grabbed = test::grabBothPolarities(grab, bits, 10);
+    EXPECT_FALSE(grabbed.positive.empty() || grabbed.negative.empty())
+        << "the screen does not show the code over the desktop";
+
+    compositor.stop();
+    EXPECT_TRUE(waitForProperty("StateReason", "closed the connection")) << get("StateReason");
+    EXPECT_EQ(get("State"), "s \"degraded\"\n");
+    compositor.start();
+    EXPECT_TRUE(test::waitUntil(
+        [this] { return get("StateReason").find("closed the connection") == std::string::npos; }, 20s))
+        << "the state still says the compositor is gone once it is back: " << get("StateReason");
+    grabbed = test::grabBothPolarities(grab, bits, 10);
+    EXPECT_FALSE(grabbed.positive.empty() || grabbed.negative.empty())
+        << "the code does not come back over the desktop";
     stopDaemon();
 }
 

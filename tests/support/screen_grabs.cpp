@@ -11,14 +11,14 @@ bool sameImage(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) <= 1.0;
 }
 
-AlternateGrabs grabAlternates(const VirtualDisplay& display, const cv::Mat& positive,
+AlternateGrabs grabAlternates(const std::function<cv::Mat()>& grab, const cv::Mat& positive,
                               const cv::Mat& negative) {
     AlternateGrabs grabbed;
     bool matched = false;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
            std::chrono::steady_clock::now() < deadline) {
-        const cv::Mat screen = display.grab();
+        const cv::Mat screen = grab();
         if (sameImage(screen, positive))
             grabbed.positive = screen;
         else if (sameImage(screen, negative))
@@ -26,6 +26,36 @@ AlternateGrabs grabAlternates(const VirtualDisplay& display, const cv::Mat& posi
         else if (matched)
             ++grabbed.others;
         matched = matched || !grabbed.positive.empty() || !grabbed.negative.empty();
+        std::this_thread::sleep_for(std::chrono::milliseconds(3));
+    }
+    return grabbed;
+}
+
+AlternateGrabs grabAlternates(const VirtualDisplay& display, const cv::Mat& positive,
+                              const cv::Mat& negative) {
+    return grabAlternates([&display] { return display.grab(); }, positive, negative);
+}
+
+AlternateGrabs grabBothPolarities(const std::function<cv::Mat()>& grab, const cv::Mat& pattern, int delta) {
+    CV_Assert(pattern.type() == CV_8UC1);
+    const cv::Mat ones = pattern != 0;
+    const cv::Mat zeros = pattern == 0;
+    AlternateGrabs grabbed;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
+           std::chrono::steady_clock::now() < deadline) {
+        const cv::Mat screen = grab();
+        if (screen.size() != pattern.size())
+            continue;
+        const cv::Scalar onOnes = cv::mean(screen, ones);
+        const cv::Scalar onZeros = cv::mean(screen, zeros);
+        const double brighter = onOnes[0] + onOnes[1] + onOnes[2] - (onZeros[0] + onZeros[1] + onZeros[2]);
+        if (brighter >= delta)
+            grabbed.positive = screen;
+        else if (brighter <= -delta)
+            grabbed.negative = screen;
+        else
+            ++grabbed.others;
         std::this_thread::sleep_for(std::chrono::milliseconds(3));
     }
     return grabbed;

@@ -19,6 +19,7 @@
 #include "support/desktop_window.h"
 #include "support/screen_grabs.h"
 #include "support/virtual_display.h"
+#include "support/wait.h"
 
 namespace everytouch::io {
 namespace {
@@ -52,16 +53,6 @@ void expectTheCode(const test::AlternateGrabs& grabbed, const cv::Mat& pattern, 
     cv::split(difference, channels);
     for (const cv::Mat& channel : channels)
         EXPECT_EQ(cv::norm(channel, bits, cv::NORM_INF), 0.0);
-}
-
-bool waitFor(const std::function<bool()>& condition, std::chrono::milliseconds timeout) {
-    const auto deadline = std::chrono::steady_clock::now() + timeout;
-    while (!condition()) {
-        if (std::chrono::steady_clock::now() > deadline)
-            return false;
-        std::this_thread::sleep_for(10ms);
-    }
-    return true;
 }
 
 class OverlayProjectorTest : public ::testing::Test {
@@ -108,13 +99,13 @@ TEST_F(OverlayProjectorComposited, BlendsTheCodeOverTheDesktopOnAlternateRefresh
 
 TEST_F(OverlayProjectorComposited, LetsClicksThroughToTheDesktop) {
     OverlayProjector overlay("", 5, kOverlayDelta, {});
-    ASSERT_TRUE(waitFor([&] { return overlay.visible(); }, 5s));
+    ASSERT_TRUE(test::waitUntil([&] { return overlay.visible(); }, 5s));
     EXPECT_TRUE(desktop_.clickReaches(cv::Point(160, 120), 2s));
 }
 
 TEST_F(OverlayProjectorComposited, StaysAboveWindowsOpenedAfterIt) {
     OverlayProjector overlay("", 5, kOverlayDelta, {});
-    ASSERT_TRUE(waitFor([&] { return overlay.visible(); }, 5s));
+    ASSERT_TRUE(test::waitUntil([&] { return overlay.visible(); }, 5s));
     const cv::Rect area(40, 30, 200, 150);
     const cv::Mat grey(area.size(), CV_8UC3, cv::Scalar::all(90));
     test::DesktopWindow later(display_.name(), area, grey);
@@ -149,15 +140,15 @@ TEST_F(OverlayProjectorComposited, ShowsACalibrationImageOpaqueWithTheCodeAndThe
 
 TEST_F(OverlayProjectorComposited, HidesWhileNoCompositorRunsAndComesBackWithOne) {
     OverlayProjector overlay("", 5, kOverlayDelta, {});
-    ASSERT_TRUE(waitFor([&] { return overlay.visible(); }, 5s));
+    ASSERT_TRUE(test::waitUntil([&] { return overlay.visible(); }, 5s));
 
     compositor_.stop();
-    ASSERT_TRUE(waitFor([&] { return !overlay.visible(); }, 2s));
+    ASSERT_TRUE(test::waitUntil([&] { return !overlay.visible(); }, 2s));
     // Its pixels must not cover the desktop as they are.
-    EXPECT_TRUE(waitFor([&] { return test::sameImage(display_.grab(), picture_); }, 2s));
+    EXPECT_TRUE(test::waitUntil([&] { return test::sameImage(display_.grab(), picture_); }, 2s));
 
     test::Compositor again(display_.name());
-    ASSERT_TRUE(waitFor([&] { return overlay.visible(); }, 5s));
+    ASSERT_TRUE(test::waitUntil([&] { return overlay.visible(); }, 5s));
     cv::Mat positive, negative;
     core::makeCodeOverlay(overlay.pattern(), kOverlayDelta, positive, negative);
     expectTheCode(test::grabAlternates(display_, test::compositedOver(positive, picture_),
@@ -193,7 +184,10 @@ TEST(OverlayProjectorWithoutDisplay, SaysThatItNeedsAnXServer) {
         OverlayProjector overlay("", 5, kOverlayDelta, {});
         FAIL() << "the overlay started without an X server";
     } catch (const std::runtime_error& error) {
-        EXPECT_THAT(error.what(), HasSubstr("needs an X server, and DISPLAY is not set"));
+        EXPECT_THAT(
+            error.what(),
+            HasSubstr(
+                "needs a Wayland compositor or an X server, and neither WAYLAND_DISPLAY nor DISPLAY is set"));
     }
 }
 
