@@ -207,7 +207,7 @@ tsan)
     install_missing_packages
     # The tests that run our code on several threads: the frame loop and what hands results between its
     # threads and the main loop, the recording's encoders and writer, the calibration job, the cameras'
-    # sources, the projector window and overlay and every test of the daemon binary. GLib, Aravis, GDAL and Mesa are not
+    # sources, the projector window and the overlays and every test of the daemon binary. GLib, Aravis, GDAL and Mesa are not
     # built with ThreadSanitizer; tests/tsan-suppressions.txt names the reports it makes of their own
     # synchronisation. A new user's "calibrate full" renders some 2200 frames, over 300 s under
     # ThreadSanitizer; the projector step end to end runs the same code on fewer. The table
@@ -219,7 +219,7 @@ tsan)
         -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG"
     TSAN_OPTIONS="suppressions=$PWD/tests/tsan-suppressions.txt halt_on_error=1" \
         ctest --test-dir build-tsan --output-on-failure -j "$jobs" \
-        -R '^(FrameLoop|FrameQueue|FrameTap|RecordingThread|CalibrationJob|CalibrationRunner|SnapshotRequests|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|WindowProjector|OverlayProjector|Everytouchd|EverytouchdConfig|EverytouchdService)' \
+        -R '^(FrameLoop|FrameQueue|FrameTap|RecordingThread|CalibrationJob|CalibrationRunner|SnapshotRequests|ArrivalRate|ServiceTest|DaemonOwnChecksTest|CameraServiceTest|AravisSource|WindowProjector|OverlayProjector|WaylandOverlayProjector|Everytouchd|EverytouchdConfig|EverytouchdService)' \
         -E '^(ServiceTest\.ANewUserCalibratesFully|CameraServiceTest\.CalibratesTheTableThrough)' "$@"
     ;;
 fuzz)

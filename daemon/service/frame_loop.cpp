@@ -106,7 +106,7 @@ std::optional<std::string> FrameLoop::failure() const {
 
 std::optional<std::string> FrameLoop::sourceLost() const {
     std::lock_guard lock(mutex_);
-    return sourceLost_;
+    return lossesReleased_ == losses_ ? sourceLost_ : std::nullopt;
 }
 
 bool FrameLoop::waitForLostSource(const std::string& reason, std::chrono::milliseconds& backOff) {
@@ -114,14 +114,14 @@ bool FrameLoop::waitForLostSource(const std::string& reason, std::chrono::millis
     const bool first = !sourceLost_;
     sourceLost_ = reason;
     if (first) {
+        const std::uint64_t loss = ++losses_;
         lock.unlock();
         ET_LOG(Error) << "camera: " << reason << "; every contact is released, and the camera is asked again "
                       << "until it answers";
-        // After the frames already queued, so that their contacts go too.
+        // After the frames already queued, so that their contacts go too; the loss is told once they have.
         QueuedFrame marker;
-        marker.sourceLost = true;
+        marker.sourceLost = loss;
         queue_.push(std::move(marker));
-        notify_();
         lock.lock();
     }
     stopRequested_.wait_for(lock, backOff, [this] { return stopping_.load(); });
@@ -400,12 +400,17 @@ void FrameLoop::runPipeline() {
             }
             if (result == FrameQueue::PopResult::Timeout || stopping_)
                 continue;
-            if (item.sourceLost) {
+            if (item.sourceLost != 0) {
                 pipeline_.reset();
                 pairer_.reset();
                 publish(lastIndex, lastTimestampUs, noContacts);
                 watchingForStall = false;  // a lost camera is not also a stalled one
                 stalledNow = false;
+                {
+                    std::lock_guard lock(mutex_);
+                    lossesReleased_ = item.sourceLost;
+                }
+                notify_();
                 continue;
             }
             if (watchingForStall && !stalledNow) {

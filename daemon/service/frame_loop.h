@@ -95,7 +95,7 @@ public:
     // Why the loop failed (camera, recording, sink); nothing after a normal end.
     std::optional<std::string> failure() const;
     // Why the source's camera cannot be reached while the loop waits for it to come back; nothing while
-    // frames come.
+    // frames come. Said once every contact the frames before the loss showed is released.
     std::optional<std::string> sourceLost() const;
 
     LoopStatistics statistics() const;
@@ -174,6 +174,8 @@ private:
     std::uint64_t contactsVersion_ = 0;
     std::optional<std::string> failure_;
     std::optional<std::string> sourceLost_;
+    std::uint64_t losses_ = 0;               // the camera's, counted by the camera thread
+    std::uint64_t lossesReleased_ = 0;       // those whose contacts the pipeline thread released
     std::condition_variable stopRequested_;  // wakes the camera thread waiting for a lost source
     core::PipelineSettings settings_;
     std::uint64_t settingsVersion_ = 0;

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 
 #include "core/frame.h"
 #include "service/bounded_queue.h"
@@ -11,8 +12,9 @@ namespace everytouch::service {
 struct QueuedFrame {
     core::Frame frame;
     std::chrono::steady_clock::time_point arrival;
-    // No frame: the source lost its camera after the frames before this one. Nothing they showed holds.
-    bool sourceLost = false;
+    // No frame: the source lost its camera after the frames before this one, for the `sourceLost`th time
+    // (counted from 1; 0 for a frame). Nothing they showed holds.
+    std::uint64_t sourceLost = 0;
 };
 
 // Hands camera frames from the camera thread to the pipeline thread.
