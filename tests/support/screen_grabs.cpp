@@ -40,17 +40,25 @@ AlternateGrabs grabBothPolarities(const std::function<cv::Mat()>& grab, const cv
     CV_Assert(pattern.type() == CV_8UC1);
     const cv::Mat ones = pattern != 0;
     const cv::Mat zeros = pattern == 0;
+    // One colour over each kind of bit, within rounding: the code over a desktop of one colour, not what
+    // the screen showed before (a calibration image) nor a grab mixing two frames.
+    const auto uniform = [](const cv::Scalar& spread) {
+        return spread[0] < 1.0 && spread[1] < 1.0 && spread[2] < 1.0;
+    };
     AlternateGrabs grabbed;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
            std::chrono::steady_clock::now() < deadline) {
         const cv::Mat screen = grab();
-        if (screen.size() != pattern.size())
+        if (screen.size() != pattern.size() || screen.type() != CV_8UC3)
             continue;
-        const cv::Scalar onOnes = cv::mean(screen, ones);
-        const cv::Scalar onZeros = cv::mean(screen, zeros);
+        cv::Scalar onOnes, onZeros, spreadOnOnes, spreadOnZeros;
+        cv::meanStdDev(screen, onOnes, spreadOnOnes, ones);
+        cv::meanStdDev(screen, onZeros, spreadOnZeros, zeros);
         const double brighter = onOnes[0] + onOnes[1] + onOnes[2] - (onZeros[0] + onZeros[1] + onZeros[2]);
-        if (brighter >= delta)
+        if (!uniform(spreadOnOnes) || !uniform(spreadOnZeros))
+            ++grabbed.others;
+        else if (brighter >= delta)
             grabbed.positive = screen;
         else if (brighter <= -delta)
             grabbed.negative = screen;

@@ -22,11 +22,12 @@ AlternateGrabs grabAlternates(const std::function<cv::Mat()>& grab, const cv::Ma
 AlternateGrabs grabAlternates(const VirtualDisplay& display, const cv::Mat& positive,
                               const cv::Mat& negative);
 
-// A screen of one colour with the code over it, grabbed within 10 s once as it shows the "+" image (the
-// pattern's 1-bits brighter than its 0-bits, by `delta` or more in the sum of the channels) and once as it
-// shows the "-" image; empty when it showed neither in that time. For a compositor whose blending under the
-// overlay is not known to the level (sway's pixman renderer lays a uniform copy of one of the overlay's
-// pixels under it), where the images it shows cannot be predicted but their difference can.
+// A screen of one colour with the code over it, grabbed within 10 s once as it shows the "+" image (one
+// colour on the pattern's 1-bits, another on its 0-bits, brighter by `delta` or more in the sum of the
+// channels) and once as it shows the "-" image; empty when it showed neither in that time. Grabs of anything
+// else (a calibration image still up, two frames mixed) are counted as others. For a compositor whose
+// blending under the overlay is not known to the level (sway's pixman renderer lays a uniform copy of one of
+// the overlay's pixels under it), where the images it shows cannot be predicted but their difference can.
 AlternateGrabs grabBothPolarities(const std::function<cv::Mat()>& grab, const cv::Mat& pattern, int delta);
 
 }  // namespace everytouch::test
