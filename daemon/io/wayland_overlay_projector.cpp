@@ -165,18 +165,24 @@ public:
         wl_callback_add_listener(frame_.get(), &kFrameListener, this);
         wl_surface_commit(surface_.get());
         framePending_ = true;
+        // The buffers replaced are attached no more once this frame is shown.
+        retireOnFrame_ = static_cast<bool>(retiring_[0]);
     }
 
     bool framePending() const { return framePending_; }
     // The compositor's time of the last frame it asked for, ms; 0 before the first.
     std::uint32_t lastFrameMs() const { return lastFrameMs_; }
-    // Whether a frame was asked for since the last call; buffers replaced before it are then done with.
+    // Whether a frame was asked for since the last call; buffers replaced before the draw it answers are
+    // then done with.
     bool takeFrameDone() {
         if (!frameDone_)
             return false;
         frameDone_ = false;
-        retiring_[0].reset();
-        retiring_[1].reset();
+        if (retireOnFrame_) {
+            retiring_[0].reset();
+            retiring_[1].reset();
+            retireOnFrame_ = false;
+        }
         return true;
     }
 
@@ -276,6 +282,7 @@ private:
     bool closed_ = false;
     bool framePending_ = false;
     bool frameDone_ = false;
+    bool retireOnFrame_ = false;
     std::uint32_t lastFrameMs_ = 0;
 };
 
