@@ -15,7 +15,7 @@ packages=(
     libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
     libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools libsdl2-dev xvfb
     libx11-dev libxext-dev libxfixes-dev libxrandr-dev libxpresent-dev libxtst-dev picom
-    libwayland-dev wayland-protocols librust-wayland-protocols-dev sway swaybg grim
+    libwayland-dev wayland-protocols librust-wayland-protocols-dev sway swaybg grim wev
     libcli11-dev nlohmann-json3-dev libinih-dev scdoc mandoc lintian
     dbus systemd udev
     qemu-system-x86 busybox-static libinput-tools evemu-tools cpio xz-utils

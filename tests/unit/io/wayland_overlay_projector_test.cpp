@@ -16,7 +16,10 @@
 #include "core/projector_chessboard.h"
 #include "io/input_error.h"
 #include "support/compositor.h"
+#include "support/process.h"
 #include "support/screen_grabs.h"
+#include "support/temp_dir.h"
+#include "support/virtual_pointer.h"
 #include "support/wait.h"
 #include "support/wayland_compositor.h"
 
@@ -108,6 +111,29 @@ TEST_F(WaylandOverlayProjectorTest, ShowsACalibrationImageOpaqueWithTheCodeAndTh
 
     overlay.release();
     expectTheCode(grabTheCodeOverTheDesktop(overlay.pattern()), overlay.pattern(), 1.0);
+}
+
+// The overlay takes no input: a click where it covers the desktop reaches the window below. wev, a real
+// client that prints what the compositor sends it, fills the output, and a virtual mouse clicks at its
+// centre.
+TEST_F(WaylandOverlayProjectorTest, AClickOnItReachesTheWindowBelow) {
+    test::TempDir runtime;
+    // Line-buffered: wev's output goes to a file the test reads while it runs.
+    test::BackgroundProcess window(
+        {"stdbuf", "-oL", "wev"}, runtime / "wev.log",
+        {{"WAYLAND_DISPLAY", compositor_.socket()}, {"XDG_RUNTIME_DIR", runtime.path().string()}});
+    ASSERT_TRUE(window.waitForOutput("activated", 10s)) << "wev's window never showed: " << window.output();
+    WaylandOverlayProjector overlay("", 5, kOverlayDelta, {});
+    ASSERT_TRUE(test::waitUntil([&] { return overlay.presented() > 2; }, 5s));
+
+    test::VirtualPointer mouse(compositor_.socket());
+    mouse.moveTo(kDesktop.width / 2, kDesktop.height / 2, kDesktop.width, kDesktop.height);
+    // The pointer's focus is the window's (its input region), not the overlay's.
+    ASSERT_TRUE(window.waitForOutput("wl_pointer] enter", 5s)) << window.output();
+    mouse.click();
+    EXPECT_TRUE(window.waitForOutput("button: 272 (left), state: 1 (pressed)", 5s)) << window.output();
+    EXPECT_TRUE(window.waitForOutput("button: 272 (left), state: 0 (released)", 5s)) << window.output();
+    EXPECT_FALSE(overlay.problem());
 }
 
 TEST_F(WaylandOverlayProjectorTest, AnUnknownOutputIsRefusedNamingThoseThatExist) {
