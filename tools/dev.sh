@@ -42,9 +42,10 @@ build() {
     local dir=$1
     shift
     local werror=OFF unity=OFF ci_flags=()
-    # CI builds from scratch: a unity build (eight sources a compiler run) parses OpenCV's, Eigen's and
-    # GoogleTest's headers an eighth as often, and line tables (-g1) instead of full debug information still
-    # name file and line in every failure and report. A developer's build keeps one source a run, so that a
+    # CI builds from scratch: a unity build (sixteen sources a compiler run) parses OpenCV's, Eigen's and
+    # GoogleTest's headers a sixteenth as often, and line tables (-g1) instead of full debug information still
+    # name file and line in every failure and report. Sixteen instead of eight took the normal build from
+    # about 460 s to about 380 s on 2 cores. A developer's build keeps one source a run, so that a
     # change recompiles one file and each file is checked to include what it uses, and full debug information.
     if [ "${CI:-}" = "true" ]; then
         werror=ON
@@ -52,7 +53,7 @@ build() {
         ci_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
     fi
     cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEVERYTOUCH_WERROR="$werror" \
-        -DCMAKE_UNITY_BUILD="$unity" -DCMAKE_UNITY_BUILD_BATCH_SIZE=8 "${ci_flags[@]}" "$@" >/dev/null
+        -DCMAKE_UNITY_BUILD="$unity" -DCMAKE_UNITY_BUILD_BATCH_SIZE=16 "${ci_flags[@]}" "$@" >/dev/null
     cmake --build "$dir" -j "$jobs"
 }
 

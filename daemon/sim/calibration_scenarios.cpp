@@ -9,14 +9,11 @@
 
 #include <opencv2/core.hpp>
 
+#include "sim/easing.h"
+
 namespace everytouch::sim {
 
 namespace {
-
-double smoother(double x) {
-    x = std::clamp(x, 0.0, 1.0);
-    return x * x * x * (x * (6.0 * x - 15.0) + 10.0);
-}
 
 Eigen::Isometry3d blend(const Eigen::Isometry3d& from, const Eigen::Isometry3d& to, double s) {
     const Eigen::Quaterniond a(from.rotation()), b(to.rotation());
@@ -325,7 +322,7 @@ SceneState PairCalibrationScenario::at(double seconds) const {
     }
     if (local >= holdEnd(last)) {
         // The board goes back towards the user and the card onto the table where it lay for the first pose.
-        const double s = smoother((local - holdEnd(last)) / kMoveSeconds);
+        const double s = smootherStep((local - holdEnd(last)) / kMoveSeconds);
         const Pose& from = poses_[last];
         BoardProp board = *from.board;
         board.faceToTable = blend(from.board->faceToTable,
@@ -345,7 +342,7 @@ SceneState PairCalibrationScenario::at(double seconds) const {
     }
     // Moving from pose k - 1 to pose k: the board comes in from the user's side for the first tilt.
     const Pose& from = poses_[k - 1];
-    const double s = smoother((local - holdEnd(k - 1)) / kMoveSeconds);
+    const double s = smootherStep((local - holdEnd(k - 1)) / kMoveSeconds);
     BoardProp board = *pose.board;
     const Eigen::Isometry3d start = from.board
                                         ? from.board->faceToTable

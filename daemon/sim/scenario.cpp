@@ -8,6 +8,7 @@
 
 #include "core/geometry.h"
 #include "sim/calibration_scenarios.h"
+#include "sim/easing.h"
 
 namespace everytouch::sim {
 
@@ -17,11 +18,6 @@ constexpr double kHoverMm = 35.0;      // height of a finger travelling between 
 constexpr double kEnterSeconds = 1.0;  // a hand coming into view or leaving it
 constexpr double kPointingPitchDeg = 30.0;
 constexpr double kUserYawDeg = -90.0;  // a hand of the user at +y points towards -y
-
-double smoother(double x) {
-    x = std::clamp(x, 0.0, 1.0);
-    return x * x * x * (x * (6.0 * x - 15.0) + 10.0);
-}
 
 // Random numbers of one cycle of one scenario.
 cv::RNG cycleRng(std::uint64_t seed, int scenarioId, long cycle) {
@@ -91,7 +87,7 @@ public:
             const Key& b = keys_[i];
             const double span = b.t - a.t;
             const double x = span > 0.0 ? (t - a.t) / span : 1.0;
-            const double s = a.linear ? x : smoother(x);
+            const double s = a.linear ? x : smootherStep(x);
             pad = a.pad + (b.pad - a.pad) * s;
             yawDeg = a.yawDeg + (b.yawDeg - a.yawDeg) * s;
             return;
@@ -317,11 +313,11 @@ public:
         state.content = ContentKind::Photo;
         state.contentVariant = static_cast<int>(cycle);
         // Phases: enter, lower, gesture, lift, leave.
-        const double enter = smoother(local / 0.9);
-        const double lower = smoother((local - 0.9) / 0.4);
-        const double act = smoother((local - 1.3) / 2.6);
-        const double lift = smoother((local - 3.9) / 0.35);
-        const double leave = smoother((local - 4.25) / 0.75);
+        const double enter = smootherStep(local / 0.9);
+        const double lower = smootherStep((local - 0.9) / 0.4);
+        const double act = smootherStep((local - 1.3) / 2.6);
+        const double lift = smootherStep((local - 3.9) / 0.35);
+        const double leave = smootherStep((local - 4.25) / 0.75);
         const double height = 25.0 * (1.0 - lower) + 25.0 * lift;
         const Eigen::Vector3d away = stage_.offstage(0.0) - stage_.centre();
         const Eigen::Vector3d offset = away * ((1.0 - enter) + leave);
@@ -450,8 +446,8 @@ public:
             natural[f] = fingerPad(pose, static_cast<Finger>(f));
         // The hand comes in and leaves as a whole.
         const double total = cycleSeconds();
-        const double in = smoother(local / kMoveSeconds),
-                     out = smoother((local - (total - kMoveSeconds)) / kMoveSeconds);
+        const double in = smootherStep(local / kMoveSeconds),
+                     out = smootherStep((local - (total - kMoveSeconds)) / kMoveSeconds);
         const Eigen::Vector3d offset = (stage_.offstage(0.0) - stage_.centre()) * ((1.0 - in) + out);
         pose.wristToTable.translation() += offset;
         // Index height: taps within the resting phase.
@@ -464,8 +460,8 @@ public:
             cv::RNG tapRng = cycleRng(seed_, 50 + tap, cycle);
             tapOffset = Eigen::Vector3d(tapRng.uniform(-8.0, 8.0), tapRng.uniform(-12.0, 4.0), 0.0);
             // Up at 15 mm, down in 0.18 s, dwell 0.25 s, up in 0.25 s.
-            indexHeight =
-                15.0 * (1.0 - smoother((phase - 0.3) / 0.18)) + 15.0 * smoother((phase - 0.73) / 0.25);
+            indexHeight = 15.0 * (1.0 - smootherStep((phase - 0.3) / 0.18)) +
+                          15.0 * smootherStep((phase - 0.73) / 0.25);
         }
         for (int f = 0; f < kFingerCount; ++f) {
             pose.presented[f] = true;

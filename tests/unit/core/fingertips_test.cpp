@@ -53,11 +53,11 @@ Eigen::Vector2d towards(double degrees) {
     return {std::cos(radians), std::sin(radians)};
 }
 
-constexpr double kWidth = 20.0;  // finger width of the drawn hands, pixels
+constexpr double kFingerWidthPx = 20.0;  // finger width of the drawn hands, pixels
 
 FingertipOptions drawnOptions() {
     FingertipOptions options;
-    options.fingerWidthPx = kWidth;
+    options.fingerWidthPx = kFingerWidthPx;
     return options;
 }
 
@@ -271,7 +271,7 @@ TEST(Fingertips, AFingerTouchingNearTheJudgedEdgeShowsItsEndAlone) {
     // 1.6-2 widths, and only that end is judged. A speck of that size inside the display is no finger.
     for (const double reach : {1.6, 2.0}) {
         ArmLeavingTheDisplay scene(-90);
-        const Capsule finger{{300, 60}, {300, 100 + reach * kWidth - 9}, 9};
+        const Capsule finger{{300, 60}, {300, 100 + reach * kFingerWidthPx - 9}, 9};
         scene.mask.setTo(0);
         fillEllipse(scene.mask, {300, 40}, 40, 32);
         fillCapsule(scene.mask, finger);

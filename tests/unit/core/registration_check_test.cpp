@@ -24,7 +24,7 @@ namespace {
 // Pairs of grid35 from frame 60 on (a hand reaches over the table): S and the hand's true mask, with the
 // rig's calibration and its true geometry. The rigs of 24 pairs are rendered once for the tests that
 // share them.
-struct Rendered {
+struct RenderedRig {
     std::vector<cv::Mat> subtractions, handMasks;
     std::vector<std::int64_t> timestampsUs;
     Calibration calibration;  // the rig's, from before any knock
@@ -35,13 +35,13 @@ struct Rendered {
 
 constexpr int kRenderedPairs = 24;
 
-Rendered render(bool knocked, int pairs) {
+RenderedRig render(bool knocked, int pairs) {
     sim::SimParameters parameters;
     parameters.scenario = "grid35";
     if (knocked)
         parameters.knockS = 0.0;
     sim::Simulator simulator(parameters, sim::rigPattern(parameters));
-    Rendered rendered;
+    RenderedRig rendered;
     rendered.calibration = simulator.calibration();
     rendered.pattern = simulator.pattern();
     HandSegmenter segmenter{SegmentationOptions{}};
@@ -63,13 +63,13 @@ Rendered render(bool knocked, int pairs) {
     return rendered;
 }
 
-const Rendered& calibratedRig() {
-    static const Rendered rendered = render(false, kRenderedPairs);
+const RenderedRig& calibratedRig() {
+    static const RenderedRig rendered = render(false, kRenderedPairs);
     return rendered;
 }
 
-const Rendered& knockedRig() {
-    static const Rendered rendered = render(true, kRenderedPairs);
+const RenderedRig& knockedRig() {
+    static const RenderedRig rendered = render(true, kRenderedPairs);
     return rendered;
 }
 
@@ -81,7 +81,7 @@ struct Checked {
 };
 
 // Runs the check over the first `pairs` pairs, with `calibration` (the rig's when not given).
-Checked check(const Rendered& rendered, int pairs, const RegistrationOptions& options = {},
+Checked check(const RenderedRig& rendered, int pairs, const RegistrationOptions& options = {},
               const std::optional<Calibration>& calibration = std::nullopt) {
     const Calibration& used = calibration ? *calibration : rendered.calibration;
     RegistrationCheck registration(options);
@@ -166,7 +166,7 @@ Eigen::Vector3d centreOf(const Eigen::Isometry3d& tableToDevice) {
 }
 
 TEST(CameraRelocation, FindsWhereTheKnockPutTheCameraAndTheCodeFitsAgain) {
-    const Rendered& rig = knockedRig();
+    const RenderedRig& rig = knockedRig();
     const Checked checked = check(rig, kRenderedPairs);
     const Result<CameraRelocation> relocated = relocateCamera(rig.calibration, checked.tiles);
     ASSERT_TRUE(relocated.ok()) << relocated.failure().message;
@@ -190,7 +190,7 @@ TEST(CameraRelocation, FindsWhereTheKnockPutTheCameraAndTheCodeFitsAgain) {
 }
 
 TEST(CameraRelocation, RefusesTooFewTilesOrTilesInOneCorner) {
-    const Rendered& rig = calibratedRig();
+    const RenderedRig& rig = calibratedRig();
     const Checked checked = check(rig, kRenderedPairs);
     std::vector<TileShift> few(checked.tiles.begin(), checked.tiles.begin() + 5);
     const Result<CameraRelocation> fromFew = relocateCamera(rig.calibration, few);
@@ -211,7 +211,7 @@ struct Corrected {
     std::string problem;
 };
 
-Corrected correct(const Rendered& rendered, int pairs) {
+Corrected correct(const RenderedRig& rendered, int pairs) {
     RegistrationCheck registration;
     registration.setRig(rendered.calibration, rendered.pattern, rendered.region, 0.5);
     CalibrationCorrector corrector;
@@ -227,7 +227,7 @@ Corrected correct(const Rendered& rendered, int pairs) {
 }
 
 TEST(CalibrationCorrector, CorrectsAKnockedCameraAndTheCodeFitsAgain) {
-    const Rendered& rig = knockedRig();
+    const RenderedRig& rig = knockedRig();
     const Corrected corrected = correct(rig, kRenderedPairs);
     ASSERT_TRUE(corrected.correction) << corrected.problem;
     const CalibrationCorrection& correction = *corrected.correction;
@@ -254,7 +254,7 @@ TEST(CalibrationCorrector, LeavesACalibrationThatHoldsAsItIs) {
 }
 
 TEST(CalibrationCorrector, RefusesAMisregistrationNoMoveOfTheCameraExplains) {
-    const Rendered& rig = calibratedRig();
+    const RenderedRig& rig = calibratedRig();
     const Checked checked = check(rig, kRenderedPairs);
     ASSERT_EQ(checked.tiles.size(), 16u);
     // Each tile's code displaced its own way by a pixel: what a warped table or a creeping, distorting
@@ -296,7 +296,7 @@ void readTiles(const Calibration& believed, const Calibration& real, double nois
 }
 
 TEST(CalibrationCorrector, CorrectsACreepingProjectorsImageAsAShiftOnItsPanelAndTheCreepAddsUp) {
-    const Rendered& rig = calibratedRig();
+    const RenderedRig& rig = calibratedRig();
     std::vector<TileShift> tiles = check(rig, kRenderedPairs).tiles;
     ASSERT_EQ(tiles.size(), 16u);
     CalibrationCorrector corrector;
@@ -337,7 +337,7 @@ TEST(CalibrationCorrector, CorrectsACreepingProjectorsImageAsAShiftOnItsPanelAnd
 }
 
 TEST(CalibrationCorrector, WatchesWithoutAProblemWhatAMoveExplainsButNotYetBeyondTheNoise) {
-    const Rendered& rig = calibratedRig();
+    const RenderedRig& rig = calibratedRig();
     const Checked checked = check(rig, kRenderedPairs);
     ASSERT_EQ(checked.tiles.size(), 16u);
     // The code a third of a pixel off as one small move of the camera would put it (a projector's image that
