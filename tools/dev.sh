@@ -45,7 +45,8 @@ build() {
     # CI builds from scratch: a unity build (sixteen sources a compiler run) parses OpenCV's, Eigen's and
     # GoogleTest's headers a sixteenth as often, and line tables (-g1) instead of full debug information still
     # name file and line in every failure and report. Sixteen instead of eight took the normal build from
-    # 462 s to 354 s on 2 cores; the sanitizer build, at -O1, took about as long (539 s against 517 s). A developer's build keeps one source a run, so that a
+    # 462 s to 354 s on 2 cores; the sanitizer build, at -O1, took 539 and 448 s in two
+    # runs against 517 s, within the runs' spread. A developer's build keeps one source a run, so that a
     # change recompiles one file and each file is checked to include what it uses, and full debug information.
     if [ "${CI:-}" = "true" ]; then
         werror=ON
