@@ -18,6 +18,7 @@
 
 #include "io/input_error.h"
 #include "io/log.h"
+#include "io/overlay_buffers.h"
 #include "io/projector_image.h"
 #include "io/wayland_handles.h"
 
@@ -148,41 +149,28 @@ public:
     wl_display* display() const { return display_.get(); }
     bool closed() const { return closed_; }
 
-    // Makes the two images (premultiplied BGRA, size()) the compositor's buffers for draw(); the ones they
-    // replace go once a frame has shown the new ones.
-    void upload(const cv::Mat images[2]) {
-        for (int k = 0; k < 2; ++k) {
-            retiring_[k] = std::move(buffers_[k]);
-            buffers_[k] = shmBuffer(images[k]);
-        }
-    }
+    // Makes the two images (premultiplied BGRA, size()) the compositor's buffers for draw().
+    void upload(const cv::Mat images[2]) { buffers_.replace(shmBuffer(images[0]), shmBuffer(images[1])); }
 
     // Shows image `polarity` from the next frame on and asks to be told when to draw the next one.
     void draw(int polarity) {
-        wl_surface_attach(surface_.get(), buffers_[polarity].get(), 0, 0);
+        wl_surface_attach(surface_.get(), buffers_.attach(polarity).get(), 0, 0);
         wl_surface_damage_buffer(surface_.get(), 0, 0, size_.width, size_.height);
         frame_.reset(wl_surface_frame(surface_.get()));
         wl_callback_add_listener(frame_.get(), &kFrameListener, this);
         wl_surface_commit(surface_.get());
         framePending_ = true;
-        // The buffers replaced are attached no more once this frame is shown.
-        retireOnFrame_ = static_cast<bool>(retiring_[0]);
     }
 
     bool framePending() const { return framePending_; }
     // The compositor's time of the last frame it asked for, ms; 0 before the first.
     std::uint32_t lastFrameMs() const { return lastFrameMs_; }
-    // Whether a frame was asked for since the last call; buffers replaced before the draw it answers are
-    // then done with.
+    // Whether a frame was asked for since the last call.
     bool takeFrameDone() {
         if (!frameDone_)
             return false;
         frameDone_ = false;
-        if (retireOnFrame_) {
-            retiring_[0].reset();
-            retiring_[1].reset();
-            retireOnFrame_ = false;
-        }
+        buffers_.frameShown();
         return true;
     }
 
@@ -270,8 +258,7 @@ private:
     std::vector<std::unique_ptr<CompositorOutput>> outputs_;
     WaylandSurface surface_;
     LayerSurface layerSurface_;
-    WaylandBuffer buffers_[2];
-    WaylandBuffer retiring_[2];
+    OverlayBuffers<WaylandBuffer> buffers_;
     WaylandCallback frame_;
     double refreshHz_ = kAssumedRefreshHz;
     int scale_ = 1;
@@ -282,7 +269,6 @@ private:
     bool closed_ = false;
     bool framePending_ = false;
     bool frameDone_ = false;
-    bool retireOnFrame_ = false;
     std::uint32_t lastFrameMs_ = 0;
 };
 
