@@ -10,19 +10,26 @@
 #include <sys/ioctl.h>
 #include <sys/mman.h>
 
+#include <array>
 #include <atomic>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
 #include <set>
 #include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "io/calibration_file.h"
 #include "io/handles.h"
 #include "io/input_error.h"
+#include "io/recording.h"
+#include "io/touch_log.h"
 #include "io/v4l2_source.h"
 #include "support/file_contents.h"
 #include "support/private_bus.h"
@@ -226,10 +233,14 @@ TEST(V4l2SourceOnVivid, ACameraThatDisconnectsIsLostAndComesBackWithoutANewSourc
     EXPECT_FALSE(back->image.empty());
 }
 
-// The loop: vivid's HDMI output shows frames of ours, its HDMI input captures them.
+// The loop: vivid's HDMI output shows frames of ours, its HDMI input captures them. `frameOf(number)` gives
+// the output's frame `number` in the layout of `fourcc`: CV_8UC1 for GREY, CV_8UC2 for YUYV.
 class LoopedFrames {
 public:
-    LoopedFrames(const std::string& output, cv::Size size) : fd_(openNode(output)), size_(size) {
+    using FrameOf = std::function<cv::Mat(std::uint32_t number)>;
+
+    LoopedFrames(const std::string& output, cv::Size size, std::uint32_t fourcc, FrameOf frameOf)
+        : fd_(openNode(output)), size_(size), frameOf_(std::move(frameOf)) {
         unsigned index = 0;
         EXPECT_EQ(::ioctl(fd_.get(), VIDIOC_S_OUTPUT, &index), 0) << std::strerror(errno);
         v4l2_dv_timings timings = V4L2_DV_BT_CEA_640X480P59_94;
@@ -238,10 +249,10 @@ public:
         format.type = V4L2_BUF_TYPE_VIDEO_OUTPUT;
         format.fmt.pix.width = static_cast<std::uint32_t>(size.width);
         format.fmt.pix.height = static_cast<std::uint32_t>(size.height);
-        format.fmt.pix.pixelformat = V4L2_PIX_FMT_GREY;
+        format.fmt.pix.pixelformat = fourcc;
         format.fmt.pix.field = V4L2_FIELD_NONE;
         EXPECT_EQ(::ioctl(fd_.get(), VIDIOC_S_FMT, &format), 0) << std::strerror(errno);
-        EXPECT_EQ(format.fmt.pix.pixelformat, V4L2_PIX_FMT_GREY);
+        EXPECT_EQ(format.fmt.pix.pixelformat, fourcc);
         bytesPerLine_ = format.fmt.pix.bytesperline;
         v4l2_requestbuffers request{};
         request.count = 4;
@@ -294,10 +305,11 @@ private:
         return buffer;
     }
     void queue(v4l2_buffer& buffer) {
-        const cv::Mat image = frame(next_++, size_);
+        const cv::Mat image = frameOf_(next_++);
+        EXPECT_EQ(image.size(), size_);
         auto* bytes = const_cast<std::uint8_t*>(buffers_[buffer.index].data());
         for (int y = 0; y < size_.height; ++y)
-            std::memcpy(bytes + y * bytesPerLine_, image.ptr(y), static_cast<std::size_t>(size_.width));
+            std::memcpy(bytes + y * bytesPerLine_, image.ptr(y), image.cols * image.elemSize());
         buffer.bytesused = bytesPerLine_ * static_cast<std::uint32_t>(size_.height);
         buffer.field = V4L2_FIELD_NONE;
         EXPECT_EQ(::ioctl(fd_.get(), VIDIOC_QBUF, &buffer), 0) << std::strerror(errno);
@@ -315,6 +327,7 @@ private:
 
     io::UniqueFd fd_;
     cv::Size size_;
+    FrameOf frameOf_;
     std::uint32_t bytesPerLine_ = 0;
     std::vector<io::MemoryMapping> buffers_;
     std::uint32_t next_ = 0;
@@ -328,7 +341,8 @@ TEST(V4l2SourceOnVivid, FramesShownOnTheLoopedOutputArriveUnchanged) {
     selectInput(nodes.capture, kHdmiInput);
     setControl(nodes.capture, "Loop Video", 1);
     setControl(nodes.capture, "OSD Text Mode", 2);  // no text of vivid's own over the frames
-    LoopedFrames looped(nodes.output, kLoopSize);
+    LoopedFrames looped(nodes.output, kLoopSize, V4L2_PIX_FMT_GREY,
+                        [](std::uint32_t number) { return LoopedFrames::frame(number, kLoopSize); });
     io::CameraSettings gray;
     gray.pixels = io::CameraPixels::Mono8;
     gray.region = cv::Rect(cv::Point(0, 0), kLoopSize);
@@ -347,8 +361,171 @@ TEST(V4l2SourceOnVivid, FramesShownOnTheLoopedOutputArriveUnchanged) {
     EXPECT_GE(seen.size(), 10u) << "the captured frames do not follow the output";
 }
 
-// everytouchd itself on the camera: it streams and counts the frames; detection needs the code's description,
-// which a camera rig does not have yet, and the daemon says so.
+// A frame as a camera sends it in YUYV (BT.601, video range): what V4l2Source decodes back into `bgr`, two
+// neighbouring pixels sharing their chroma.
+cv::Mat yuyvOf(const cv::Mat& bgr) {
+    cv::Mat yuyv(bgr.size(), CV_8UC2);
+    const auto level = [](double value) { return cv::saturate_cast<std::uint8_t>(value); };
+    for (int y = 0; y < bgr.rows; ++y)
+        for (int x = 0; x + 1 < bgr.cols; x += 2) {
+            double u = 0.0, v = 0.0;
+            for (int k = 0; k < 2; ++k) {
+                const cv::Vec3b pixel = bgr.at<cv::Vec3b>(y, x + k);
+                const double b = pixel[0], g = pixel[1], r = pixel[2];
+                yuyv.at<cv::Vec2b>(y, x + k)[0] = level(16.0 + 0.257 * r + 0.504 * g + 0.098 * b);
+                u += 128.0 - 0.148 * r - 0.291 * g + 0.439 * b;
+                v += 128.0 + 0.439 * r - 0.368 * g - 0.071 * b;
+            }
+            yuyv.at<cv::Vec2b>(y, x)[1] = level(u / 2.0);
+            yuyv.at<cv::Vec2b>(y, x + 1)[1] = level(v / 2.0);
+        }
+    return yuyv;
+}
+
+// The touch log as far as the daemon has written it; an entry it is still writing is left for the next look.
+std::vector<io::TouchLogEntry> touchLogSoFar(const std::filesystem::path& path) {
+    try {
+        return io::readTouchLog(path);
+    } catch (const io::InputError&) {
+        return {};
+    }
+}
+
+// The touching contacts of the log's last entry.
+std::vector<core::Contact> touchingNow(const std::vector<io::TouchLogEntry>& log) {
+    std::vector<core::Contact> touching;
+    if (!log.empty())
+        for (const core::Contact& contact : log.back().contacts)
+            if (contact.touching && !contact.palm)
+                touching.push_back(contact);
+    return touching;
+}
+
+// Positions in the recording of two consecutive frames whose true fingers all satisfy `holds` (at least one
+// finger when `needFinger`), the last such two.
+std::optional<std::size_t> lastPairWhere(const io::Recording& recording, bool needFinger,
+                                         const std::function<bool(const core::FingerTruth&)>& holds) {
+    const auto frameHolds = [&](std::uint64_t index) {
+        bool any = false;
+        for (const core::FingerTruth& finger : recording.truth())
+            if (finger.frameIndex == index) {
+                if (!holds(finger))
+                    return false;
+                any = true;
+            }
+        return any || !needFinger;
+    };
+    const std::vector<io::FrameEntry>& frames = recording.frames();
+    for (std::size_t position = frames.size() - 1; position >= 1; --position)
+        if (frameHolds(frames[position].index) && frameHolds(frames[position - 1].index))
+            return position - 1;
+    return std::nullopt;
+}
+
+// everytouchd detecting a touch through the V4L2 capture path: frames the simulated rig rendered (the
+// recording run-vm-test.sh makes on the host) go out through vivid's HDMI output as YUYV, come back through
+// its HDMI input, and the daemon reads them as any camera, knowing the rig's calibration and, as from a
+// projector that embeds the code itself, its pattern. The pipeline runs a few pairs a second under emulation,
+// far slower than the camera's 60 frames, so each scene is one pair of consecutive frames shown in turn:
+// whichever frames the daemon has to leave out, two in a row hold the code. First the finger resting on the
+// table, then the table after the finger lifted: the daemon touches down where the finger rests and lifts.
+TEST(V4l2SourceOnVivid, TheDaemonDetectsARecordedTouchThroughTheCamera) {
+    VividNodes nodes;
+    SKIP_WITHOUT_VIVID(nodes);
+    const char* recordingPath = std::getenv("EVERYTOUCH_TEST_RECORDING");
+    if (!recordingPath)
+        GTEST_SKIP() << "EVERYTOUCH_TEST_RECORDING names no recording with a touch (tests/vm sets it)";
+    const io::Recording recording = io::Recording::open(recordingPath);
+    ASSERT_TRUE(recording.hasTruth()) << recordingPath << " has no truth.csv";
+    const std::optional<std::size_t> resting = lastPairWhere(
+        recording, true, [](const core::FingerTruth& finger) { return finger.heightMm == 0.0; });
+    const std::optional<std::size_t> lifted = lastPairWhere(
+        recording, false, [](const core::FingerTruth& finger) { return finger.heightMm >= 10.0; });
+    ASSERT_TRUE(resting && lifted && *resting < *lifted)
+        << recordingPath << " has no finger resting on the table and lifted after";
+
+    // The loop carries 640x480: the recording's frames lose their last columns and rows, the calibration
+    // keeps its camera model, whose pixels keep their places.
+    const auto scene = [&](std::size_t position) {
+        std::array<cv::Mat, 2> frames;
+        for (std::size_t k = 0; k < 2; ++k)
+            frames[k] = yuyvOf(recording.loadFrame(position + k).image(cv::Rect(cv::Point(0, 0), kLoopSize)));
+        return frames;
+    };
+    const std::array<std::array<cv::Mat, 2>, 2> scenes{scene(*resting), scene(*lifted)};
+    std::atomic<std::size_t> shown{0};
+
+    const test::TempDir dir;
+    core::Calibration calibration = recording.rig().calibration;
+    ASSERT_GE(calibration.cameraSize.width, kLoopSize.width);
+    ASSERT_GE(calibration.cameraSize.height, kLoopSize.height);
+    calibration.cameraSize = kLoopSize;
+    io::writeCalibrationFile(dir.path() / "calibration.yml", calibration);
+    // The daemon reads the pattern it keeps for its seed before it would generate it (minutes under
+    // emulation): the recording's rig is the simulated rig of seed 1 (tests/vm/CMakeLists.txt), and this is
+    // its pattern.
+    const cv::Size projector = calibration.projectorSize;
+    io::writePatternImage(dir.path() / ("pattern-seed1-" + std::to_string(projector.width) + "x" +
+                                        std::to_string(projector.height) + ".png"),
+                          recording.rig().pattern);
+    std::ofstream(dir.path() / "everytouchd.conf")
+        << "[Camera]\nRig=v4l2:" << nodes.capture << "\nRegion=" << kLoopSize.width << "x" << kLoopSize.height
+        << "\n[Projector]\nOutput=external\nSeed=1\nDelta=" << recording.rig().delta
+        << "\n[Output]\nUinput=no\n[Calibration]\nPath=" << (dir.path() / "calibration.yml").string() << "\n";
+
+    selectInput(nodes.capture, kHdmiInput);
+    setControl(nodes.capture, "Loop Video", 1);
+    setControl(nodes.capture, "OSD Text Mode", 2);
+    LoopedFrames looped(nodes.output, kLoopSize, V4L2_PIX_FMT_YUYV,
+                        [&](std::uint32_t number) { return scenes[shown.load()][number % 2]; });
+    const test::PrivateBus bus("", true);
+    const char* daemonPath = std::getenv("EVERYTOUCHD");
+    ASSERT_TRUE(daemonPath) << "EVERYTOUCHD names the daemon";
+    const std::filesystem::path touchLog = dir.path() / "touches.jsonl";
+    test::BackgroundProcess daemon(
+        {daemonPath, "--config", (dir.path() / "everytouchd.conf").string(), "--log", touchLog.string()},
+        dir.path() / "daemon.log");
+    const auto waitFor = [&](const auto& condition) {
+        const auto deadline = std::chrono::steady_clock::now() + 180s;
+        while (std::chrono::steady_clock::now() < deadline && daemon.running()) {
+            if (condition(touchLogSoFar(touchLog)))
+                return true;
+            std::this_thread::sleep_for(200ms);
+        }
+        return false;
+    };
+
+    std::vector<core::Contact> down;
+    ASSERT_TRUE(waitFor([&](const std::vector<io::TouchLogEntry>& log) {
+        down = touchingNow(log);
+        return !down.empty();
+    })) << "no touch through the camera\n"
+        << daemon.output();
+    ASSERT_EQ(down.size(), 1u);
+    const std::uint64_t restingIndex = recording.frames()[*resting + 1].index;
+    for (const core::FingerTruth& finger : recording.truth())
+        if (finger.frameIndex == restingIndex) {
+            const cv::Size2d mm = calibration.displaySizeMm();
+            const double errorMm =
+                std::hypot((down[0].x - finger.x) * mm.width / calibration.displaySize.width,
+                           (down[0].y - finger.y) * mm.height / calibration.displaySize.height);
+            // Half a finger's width, as everytouch-eval matches a touch to a finger.
+            EXPECT_LE(errorMm, 8.0) << "touch at (" << down[0].x << ", " << down[0].y << "), finger at ("
+                                    << finger.x << ", " << finger.y << ")";
+        }
+
+    shown = 1;
+    EXPECT_TRUE(waitFor([](const std::vector<io::TouchLogEntry>& log) { return touchingNow(log).empty(); }))
+        << "the touch stayed down after the finger lifted\n"
+        << daemon.output();
+    daemon.signal(SIGTERM);
+    const std::optional<int> status = daemon.wait(60s);
+    ASSERT_TRUE(status) << daemon.output();
+    EXPECT_EQ(*status, 0) << daemon.output();
+    std::cout << daemon.output();
+}
+
+// everytouchd itself on the camera without a calibration: it streams and counts the frames.
 TEST(V4l2SourceOnVivid, TheDaemonRunsOnTheCamera) {
     VividNodes nodes;
     SKIP_WITHOUT_VIVID(nodes);
