@@ -26,6 +26,13 @@ constexpr double kTurnStepRad = 1e-6;
 constexpr double kShiftStepMm = 1e-3;
 // Step of the camera-to-projector map's derivative, camera pixels: the map is smooth over a pixel.
 constexpr double kPixelStep = 0.5;
+// Steps of the derivatives by the table's plane: a microradian's tilt and a micrometre's lift, as for the
+// camera's pose.
+constexpr double kTableTurnStepRad = 1e-6;
+constexpr double kTableLiftStepMm = 1e-3;
+// Gauss-Newton steps that refine the table's plane from the first one's linear fit: a tilt of several
+// degrees moves the code nearly linearly, and each step takes what is left to a small fraction.
+constexpr int kTableSteps = 4;
 // Step of the derivative by the projector image's shift, projector pixels: the shift moves every panel pixel
 // by itself, so the map is linear in it.
 constexpr double kImageStepPx = 0.1;
@@ -48,6 +55,46 @@ Eigen::Isometry3d movedPose(const Eigen::Isometry3d& pose, const Vector6d& move)
 Eigen::Vector2d seenAt(const CameraModel& camera, const Eigen::Isometry3d& pose,
                        const Eigen::Vector3d& point) {
     return camera.project(pose * point);
+}
+
+// The table's plane moved by `move` under the rig: turned by move[0] and move[1] radians about the table's x
+// and y axes through `centre` (table mm), then lifted by move[2] mm. A point of the moved table at X lies at
+// the returned transform times X in the table's frame from before.
+Eigen::Isometry3d movedTable(const Eigen::Vector3d& move, const Eigen::Vector3d& centre) {
+    Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d turn(move.x(), move.y(), 0.0);
+    if (const double angle = turn.norm(); angle > 0.0)
+        moved.linear() = Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix();
+    moved.translation() = centre - moved.linear() * centre + Eigen::Vector3d(0.0, 0.0, move.z());
+    return moved;
+}
+
+// The rig against the table moved by `table` (movedTable): both devices keep their places, the table's frame
+// moves.
+Calibration withTableMoved(const Calibration& calibration, const Eigen::Isometry3d& table) {
+    Calibration moved = calibration;
+    moved.tableToCamera = calibration.tableToCamera * table;
+    moved.tableToProjector = calibration.tableToProjector * table;
+    return moved;
+}
+
+// Solves the least-squares normal equations of N parameters of different units: balanced by their diagonal,
+// with the directions the tiles cannot tell apart dropped (a far camera's turn and shift nearly trade for
+// each other).
+template <int N>
+Eigen::Matrix<double, N, 1> solveBalanced(const Eigen::Matrix<double, N, N>& normal,
+                                          const Eigen::Matrix<double, N, 1>& right) {
+    using Vector = Eigen::Matrix<double, N, 1>;
+    const Vector scale = normal.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
+    const Eigen::Matrix<double, N, N> balanced = scale.asDiagonal() * normal * scale.asDiagonal();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> solver(balanced);
+    const Vector along = solver.eigenvectors().transpose() * (scale.asDiagonal() * right);
+    const double largest = solver.eigenvalues().maxCoeff();
+    Vector solved = Vector::Zero();
+    for (int k = 0; k < N; ++k)
+        if (solver.eigenvalues()[k] > 1e-9 * largest)
+            solved[k] = along[k] / solver.eigenvalues()[k];
+    return scale.asDiagonal() * (solver.eigenvectors() * solved);
 }
 
 // The projector's image shifted on its panel by `shiftPx`: its principal point moved.
@@ -78,6 +125,10 @@ void CalibrationCorrector::setRig(const Calibration& calibration, int tilesPerRo
         throw std::invalid_argument("calibration correction: a round needs at least " +
                                     std::to_string(kMinRelocationTiles) + " tiles");
     calibration_ = calibration;
+    const Eigen::Vector2d centre = applyHomography(
+        calibration.displayToTableHomography(),
+        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    tableCentre_ = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
     tilesPerRound_ = tilesPerRound;
     terms_.reserve(static_cast<std::size_t>(tilesPerRound));
     residuals_.reserve(static_cast<std::size_t>(tilesPerRound));
@@ -136,7 +187,17 @@ void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
                 (seenAt(camera, pose, Eigen::Vector3d(stepped.x(), stepped.y(), 0.0)) - predicted) /
                 kImageStepPx;
         }
+        Eigen::Matrix<double, 2, 3> tableDerivative;
+        for (int k = 0; k < 3; ++k) {
+            Eigen::Vector3d move = Eigen::Vector3d::Zero();
+            move[k] = k < 2 ? kTableTurnStepRad : kTableLiftStepMm;
+            tableDerivative.col(k) = (seenThrough(withTableMoved(calibration, movedTable(move, tableCentre_)),
+                                                  camera, geometry.panelPixel) -
+                                      predicted) /
+                                     move[k];
+        }
         terms_.push_back({geometry, geometry.toProjector * derivative, geometry.toProjector * imageDerivative,
+                          geometry.toProjector * tableDerivative,
                           geometry.toProjector * (geometry.observed - predicted), true, 0.0});
     }
 }
@@ -154,18 +215,7 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMove() {
         squares += term.shift.squaredNorm();
         ++used;
     }
-    // Turns and shifts differ in scale by the camera's distance, and a far camera's turn and shift nearly
-    // trade for each other: the equations are balanced, and directions the tiles cannot tell apart dropped.
-    const Vector6d scale = normal.diagonal().cwiseMax(1e-300).cwiseSqrt().cwiseInverse();
-    const Eigen::Matrix<double, 6, 6> balanced = scale.asDiagonal() * normal * scale.asDiagonal();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> solver(balanced);
-    const Vector6d along = solver.eigenvectors().transpose() * (scale.asDiagonal() * right);
-    const double largest = solver.eigenvalues().maxCoeff();
-    Vector6d solved = Vector6d::Zero();
-    for (int k = 0; k < 6; ++k)
-        if (solver.eigenvalues()[k] > 1e-9 * largest)
-            solved[k] = along[k] / solver.eigenvalues()[k];
-    const Vector6d move = scale.asDiagonal() * (solver.eigenvectors() * solved);
+    const Vector6d move = solveBalanced<6>(normal, right);
     double left = 0.0;
     for (TileTerm& term : terms_) {
         term.residualPx = (term.shift - term.onPanel * move).norm();
@@ -206,6 +256,57 @@ CalibrationCorrector::Fit CalibrationCorrector::fitImageShift(Eigen::Vector2d& s
         if (term.inlier)
             left += (term.shift - term.imageOnPanel * shiftPx).squaredNorm();
     return summarise(squares, left, used, 2);
+}
+
+Eigen::Vector2d CalibrationCorrector::seenThrough(const Calibration& calibration, const CameraModel& camera,
+                                                  const Eigen::Vector2d& panelPixel) {
+    const Eigen::Vector2d lit =
+        applyHomography(calibration.tableToProjectorHomography().inverse(), panelPixel);
+    return seenAt(camera, calibration.tableToCamera, Eigen::Vector3d(lit.x(), lit.y(), 0.0));
+}
+
+CalibrationCorrector::Fit CalibrationCorrector::fitTable(Eigen::Vector3d& move) const {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d right = Eigen::Vector3d::Zero();
+    double squares = 0.0;
+    int used = 0;
+    for (const TileTerm& term : terms_) {
+        if (!term.inlier)
+            continue;
+        normal += term.tableOnPanel.transpose() * term.tableOnPanel;
+        right += term.tableOnPanel.transpose() * term.shift;
+        squares += term.shift.squaredNorm();
+        ++used;
+    }
+    move = solveBalanced<3>(normal, right);
+    double left = 0.0;
+    for (const TileTerm& term : terms_)
+        if (term.inlier)
+            left += (term.shift - term.tableOnPanel * move).squaredNorm();
+    return summarise(squares, left, used, 3);
+}
+
+Calibration CalibrationCorrector::refinedTable(Eigen::Vector3d move) const {
+    const Calibration& calibration = *calibration_;
+    const CameraModel camera{calibration.cameraMatrix, calibration.cameraDistortion};
+    // Gauss-Newton with the derivatives at the calibration: each step fits what the plane moved so far
+    // leaves.
+    for (int step = 1; step < kTableSteps; ++step) {
+        const Calibration moved = withTableMoved(calibration, movedTable(move, tableCentre_));
+        Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d right = Eigen::Vector3d::Zero();
+        for (const TileTerm& term : terms_) {
+            if (!term.inlier)
+                continue;
+            const Eigen::Vector2d left =
+                term.geometry.toProjector *
+                (term.geometry.observed - seenThrough(moved, camera, term.geometry.panelPixel));
+            normal += term.tableOnPanel.transpose() * term.tableOnPanel;
+            right += term.tableOnPanel.transpose() * left;
+        }
+        move += solveBalanced<3>(normal, right);
+    }
+    return withTableMoved(calibration, movedTable(move, tableCentre_));
 }
 
 CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vector<TileShift>& tiles) {
@@ -270,13 +371,19 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     const Fit move = fitMoveRobustly(latest);
     Eigen::Vector2d imageShiftPx;
     const Fit image = fitImageShift(imageShiftPx);
+    Eigen::Vector3d tableMove;
+    const Fit table = fitTable(tableMove);
     // What would count as the calibration holding (below) is what a correction may leave.
     const double allowedPx =
         std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0));
     // The simplest explanation that suffices: a creep corrected as many small moves of the camera adds up to
     // a pose that no longer fits, while a knock leaves far more than allowedPx after any shift of the image.
+    // Then the table's plane (three parameters), before the camera's six: a tilted table corrected as a move
+    // of the camera leaves the code registered on the plane but the camera where it is not, and beyond a
+    // few degrees not even that.
     const bool imageCrept = image.leftPx <= allowedPx;
-    const Fit& fit = imageCrept ? image : move;
+    const bool tableMoved = !imageCrept && table.leftPx <= allowedPx;
+    const Fit& fit = imageCrept ? image : tableMoved ? table : move;
     const double notableNoisePx = options_.noiseMultiple * fit.noisePx;
     if (fit.beforePx < allowedPx) {
         // The calibration holds: what the tiles show is their noise.
@@ -296,8 +403,8 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
         std::snprintf(
             figures, sizeof figures,
             "the code lies %.2f projector px from where the calibration puts it, and no move of the "
-            "camera or shift of the projector's image explains it: the one that fits best leaves "
-            "%.2f px",
+            "camera or of the table or shift of the projector's image explains it: the one that fits best "
+            "leaves %.2f px",
             fit.beforePx, fit.noisePx);
         return off(figures);
     }
@@ -310,6 +417,9 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     if (imageCrept) {
         correction.calibration.projectorMatrix = shiftedImage(calibration_->projectorMatrix, imageShiftPx);
         correction.what = "projector";
+    } else if (tableMoved) {
+        correction.calibration = refinedTable(tableMove);
+        correction.what = "table";
     } else {
         Result<CameraRelocation> relocation = relocateCamera(*calibration_, inliers_);
         if (!relocation.ok())

@@ -32,30 +32,34 @@ struct CalibrationCorrection {
     Calibration calibration;  // the corrected one
     double beforePx = 0.0;    // the misregistration over the tiles it rests on, RMS, projector pixels
     double afterPx = 0.0;     // what the corrected calibration leaves of it, RMS, projector pixels
-    std::string what;         // what moved: "camera", or "projector" (its image crept on its panel)
+    std::string what;         // what moved: "camera", "table" (its plane under the rig), or "projector"
+                              // (its image crept on its panel)
     int tiles = 0;
 };
 
-// Keeps the calibration true when the camera is knocked or its mount sags, or the projector's image creeps as
-// a warm projector's does. After every round of tiles the registration check measures
-// (core/registration_check.h), it fits two explanations to their shifts by least squares (in projector
-// pixels, the scale the code is read in): a small move of the camera against the table (the shifts each of
-// the camera pose's six parameters would cause), and a shift of the projector's image on its panel (its
-// principal point: the same shift of every projector pixel, two parameters). The image's shift is taken
-// whenever what it leaves would count as the calibration holding (below): a small move of the camera also
-// shifts the code nearly evenly, but a creep corrected as many such moves adds up to a pose that no longer
-// fits (the whole table 0.2-0.3 px off after 9 px of creep), while a knocked camera leaves far more after any
-// shift of the image. What the chosen explanation leaves is the tiles' noise. When it explains a
+// Keeps the calibration true when the camera is knocked or its mount sags, the table tilts under the rig, or
+// the projector's image creeps as a warm projector's does. After every round of tiles the registration check
+// measures (core/registration_check.h), it fits three explanations to their shifts by least squares (in
+// projector pixels, the scale the code is read in): a small move of the camera against the table (the shifts
+// each of the camera pose's six parameters would cause), a move of the table's plane under both devices
+// (turns about its two level axes through the display's centre and a lift: three parameters), and a shift of
+// the projector's image on its panel (its principal point: the same shift of every projector pixel, two
+// parameters). The image's shift is taken whenever what it leaves would count as the calibration holding
+// (below), else the table's plane when what it leaves would, else the camera's move: a small move of the
+// camera also shifts the code nearly evenly, but a creep corrected as many such moves adds up to a pose that
+// no longer fits (the whole table 0.2-0.3 px off after 9 px of creep), while a knocked camera leaves far more
+// after any shift of the image. What the chosen explanation leaves is the tiles' noise. When it explains a
 // misregistration that is large against that noise and against leastErrorPx, the calibration is corrected
-// (the camera's pose estimated anew from the tiles, core/camera_relocation.h; or the projector's principal
-// point moved by the fitted shift) and the correction kept when it leaves less than leastErrorPx or no more
-// than noiseMultiple times the noise seen while the calibration held (or, before any such round, the noise of
-// this one). The calibration holds while the misregistration stays below leastErrorPx and below noiseMultiple
-// times that noise. A misregistration that neither explains, leaving leastErrorPx or more (the table tilted),
-// is not corrected; problem() says why once two rounds running found it. One that an explanation accounts for
-// but not yet clearly beyond the noise, leaving less than leastErrorPx, is watched without a problem. Tiles
-// far off the move that fits the others (a peak of chance, a tile read while the camera moved) are set aside
-// first. Pure; a round that finds nothing allocates nothing.
+// (the camera's pose estimated anew from the tiles, core/camera_relocation.h; the table's plane moved by
+// the fitted move, refined over the tiles; or the projector's principal point moved by the fitted shift) and
+// the correction kept when it leaves less than leastErrorPx or no more than noiseMultiple times the noise
+// seen while the calibration held (or, before any such round, the noise of this one). The calibration holds
+// while the misregistration stays below leastErrorPx and below noiseMultiple times that noise. A
+// misregistration that none explains, leaving leastErrorPx or more (a warped table), is not corrected;
+// problem() says why once two rounds running found it. One that an explanation accounts for but not yet
+// clearly beyond the noise, leaving less than leastErrorPx, is watched without a problem. Tiles far off the
+// move that fits the others (a peak of chance, a tile read while the camera moved) are set aside first. Pure;
+// a round that finds nothing allocates nothing.
 class CalibrationCorrector {
 public:
     // Throws std::invalid_argument when options.validate() fails.
@@ -97,6 +101,7 @@ private:
         TileGeometry geometry;
         Eigen::Matrix<double, 2, 6> onPanel;
         Eigen::Matrix2d imageOnPanel;
+        Eigen::Matrix<double, 2, 3> tableOnPanel;
         Eigen::Vector2d shift;
         bool inlier = true;
         double residualPx = 0.0;  // what the last fit left of the shift
@@ -109,12 +114,21 @@ private:
     Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
     // The shift of the projector's image on its panel that fits the inlier terms best.
     Fit fitImageShift(Eigen::Vector2d& shiftPx) const;
+    // The move of the table's plane (turns about its x and y axes through the display's centre, radians;
+    // a lift, mm) that fits the inlier terms best, linearised.
+    Fit fitTable(Eigen::Vector3d& move) const;
+    // The calibration with the table's plane moved, refined from the linear fit `move` over the inlier terms.
+    Calibration refinedTable(Eigen::Vector3d move) const;
+    // Where the camera of `calibration` sees the light of projector pixel `panelPixel` on its table.
+    static Eigen::Vector2d seenThrough(const Calibration& calibration, const CameraModel& camera,
+                                       const Eigen::Vector2d& panelPixel);
     // RMS distance, projector pixels, between each inlier tile's observed place and where `corrected` puts
     // the table point its panel pixel lights.
     double inlierMisregistrationPx(const Calibration& corrected) const;
 
     CorrectionOptions options_;
     std::optional<Calibration> calibration_;
+    Eigen::Vector3d tableCentre_ = Eigen::Vector3d::Zero();  // the display's centre on the table, mm
     int tilesPerRound_ = 16;
     std::uint64_t judged_ = 0;           // the check's tile count at the last round
     std::optional<double> heldNoisePx_;  // the tiles' noise in the last round that found nothing to correct

@@ -44,8 +44,8 @@ struct DetectionOptions {
     HeightOptions height{.maxHeightMm = 60.0};
     TrackerOptions tracker;
     RegistrationOptions registration;
-    // Whether a calibration the code shows to be off, because the camera moved or the projector's image
-    // crept, is corrected while detection runs (core/calibration_correction.h), and how.
+    // Whether a calibration the code shows to be off, because the camera or the table moved or the
+    // projector's image crept, is corrected while detection runs (core/calibration_correction.h), and how.
     bool correctCalibration = true;
     CorrectionOptions correction;
     // A finger's width (mm): with the calibration's scale it sets the fingertip search's scale.
@@ -99,9 +99,9 @@ struct PipelineResult {
     // How far the code on the table lies from where the calibration puts it, projector pixels
     // (core/registration_check.h): from the latest tiles measured; nothing until enough were.
     std::optional<double> calibrationErrorPx;
-    // Set in the pair after which the pipeline works with a corrected calibration (the camera moved, or the
-    // projector's image crept): it goes on with it, contacts and all, for as long as its settings hold the
-    // calibration it corrected.
+    // Set in the pair after which the pipeline works with a corrected calibration (the camera or the table
+    // moved, or the projector's image crept): it goes on with it, contacts and all, for as long as its
+    // settings hold the calibration it corrected.
     std::optional<CalibrationCorrection> correction;
     // Why a calibration the code shows to be off was not corrected, or why no contact is reported while it
     // is off (heldBack); empty otherwise.

@@ -520,10 +520,18 @@ void Daemon::onLoopNews() {
 
 void Daemon::adoptCorrection(const core::CalibrationCorrection& correction) {
     // A calibration made or reset since the pipeline corrected the one it had is newer than the correction.
+    // A correction keeps the intrinsics and the keystone, and the projector's pose against the table unless
+    // the table moved, which keeps the projector's pose against the camera.
     const std::optional<core::Calibration>& active = store_->active();
     if (calibration_ || !active || active->cameraMatrix != correction.calibration.cameraMatrix ||
-        !active->tableToProjector.isApprox(correction.calibration.tableToProjector) ||
         active->displayToProjector != correction.calibration.displayToProjector)
+        return;
+    const auto cameraToProjector = [](const core::Calibration& calibration) {
+        return calibration.tableToProjector * calibration.tableToCamera.inverse();
+    };
+    if (correction.what == "table"
+            ? !cameraToProjector(*active).isApprox(cameraToProjector(correction.calibration))
+            : !active->tableToProjector.isApprox(correction.calibration.tableToProjector))
         return;
     store_->activate(correction.calibration);
     applySettings();

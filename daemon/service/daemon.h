@@ -115,8 +115,8 @@ private:
     void onLoopNews();
     void emitContacts();
     void finishCalibration(const CalibrationOutcome& outcome);
-    // The pipeline corrected the calibration (the camera moved, or the projector's image crept): it becomes
-    // the active one, is saved when the daemon keeps a file, and is announced.
+    // The pipeline corrected the calibration (the camera or the table moved, or the projector's image crept):
+    // it becomes the active one, is saved when the daemon keeps a file, and is announced.
     void adoptCorrection(const core::CalibrationCorrection& correction);
     void applySettings();
     core::PipelineSettings pipelineSettings() const;

@@ -186,6 +186,13 @@ const std::vector<OptionEntry>& entries() {
          number(&SimParameters::tableShiftMm)},
         {{"table_shift_deg", "how far the sliding table turns about the vertical, degrees (default 1)"},
          number(&SimParameters::tableShiftDeg)},
+        {{"table_tilt",
+          "the table tilts this many seconds into the session: it turns by table_tilt_deg about a level axis "
+          "through the display's centre under the rig, whose calibration stays as it was (default: never)"},
+         optionalNumber(&SimParameters::tableTiltS)},
+        {{"table_tilt_deg",
+          "how far the table tilts, about a level axis in a random direction, degrees (default 1)"},
+         number(&SimParameters::tableTiltDeg)},
         {{"drift_px_per_min",
           "the projector's image creeps across the table at this rate, in a random direction, projector "
           "pixels per minute, while the calibration stays as it was (default 0)"},

@@ -49,6 +49,10 @@ std::optional<std::string> SimParameters::validate() const {
         return "table_shift_mm: must be a number of millimetres from 0 to 100";
     if (!nonNegative(tableShiftDeg) || tableShiftDeg > 10.0)
         return "table_shift_deg: must be a number of degrees from 0 to 10";
+    if (tableTiltS && !nonNegative(*tableTiltS))
+        return "table_tilt: must be a number of seconds >= 0";
+    if (!nonNegative(tableTiltDeg) || tableTiltDeg > 10.0)
+        return "table_tilt_deg: must be a number of degrees from 0 to 10";
     if (!nonNegative(driftPxPerMin) || driftPxPerMin > 60.0)
         return "drift_px_per_min: must be a number of projector pixels per minute from 0 to 60";
     if (cameraSize.width < 16 || cameraSize.height < 16)

@@ -49,6 +49,9 @@ struct SimParameters {
     std::optional<double> tableShiftS;  // at this session time the table slides by tableShiftMm in a random
     double tableShiftMm = 5.0;          // (seeded) direction and turns by tableShiftDeg about the vertical
     double tableShiftDeg = 1.0;         // through the display's centre
+    // --- the table tilts (a leg on a cable): its plane turns under the rig, which stays ---
+    std::optional<double> tableTiltS;  // at this session time the table turns by tableTiltDeg about a level
+    double tableTiltDeg = 1.0;         // axis through the display's centre, its direction random (seeded)
     // The projector's image creeps across the table at this rate, projector pixels per minute, in a random
     // (seeded) direction, as a warming projector's does; the calibration stays as it was. 0: it holds.
     double driftPxPerMin = 0.0;

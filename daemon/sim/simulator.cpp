@@ -160,19 +160,34 @@ Eigen::Isometry3d Simulator::knockedTableToCamera() const {
     return after;
 }
 
+Eigen::Vector3d Simulator::displayCentreOnTable() const {
+    const Eigen::Vector2d centre = core::applyHomography(
+        calibration_.displayToTableHomography(),
+        Eigen::Vector2d(calibration_.displaySize.width / 2.0, calibration_.displaySize.height / 2.0));
+    return {centre.x(), centre.y(), 0.0};
+}
+
 Eigen::Isometry3d Simulator::tableSlide() const {
     std::mt19937_64 random(mix(parameters_.seed ^ 0x736C696465ull));
     const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
     const double turn = (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * parameters_.tableShiftDeg;
-    const Eigen::Vector2d centre2 = core::applyHomography(
-        calibration_.displayToTableHomography(),
-        Eigen::Vector2d(calibration_.displaySize.width / 2.0, calibration_.displaySize.height / 2.0));
-    const Eigen::Vector3d centre(centre2.x(), centre2.y(), 0.0);
+    const Eigen::Vector3d centre = displayCentreOnTable();
     Eigen::Isometry3d slide = Eigen::Isometry3d::Identity();
     slide.linear() = Eigen::AngleAxisd(turn * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     slide.translation() = centre - slide.linear() * centre +
                           parameters_.tableShiftMm * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0.0);
     return slide;
+}
+
+Eigen::Isometry3d Simulator::tableTilt() const {
+    std::mt19937_64 random(mix(parameters_.seed ^ 0x74696C74ull));
+    const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
+    const Eigen::Vector3d centre = displayCentreOnTable();
+    const Eigen::Vector3d axis(std::cos(angle), std::sin(angle), 0.0);
+    Eigen::Isometry3d tilt = Eigen::Isometry3d::Identity();
+    tilt.linear() = Eigen::AngleAxisd(parameters_.tableTiltDeg * M_PI / 180.0, axis).toRotationMatrix();
+    tilt.translation() = centre - tilt.linear() * centre;
+    return tilt;
 }
 
 Eigen::Vector2d Simulator::driftDirection() const {
@@ -185,6 +200,7 @@ Simulator::Placement Simulator::placementAt(double seconds) const {
     Placement placement;
     placement.knocked = parameters_.knockS && seconds >= *parameters_.knockS;
     placement.tableShifted = parameters_.tableShiftS && seconds >= *parameters_.tableShiftS;
+    placement.tableTilted = parameters_.tableTiltS && seconds >= *parameters_.tableTiltS;
     // The image creeps in steps far below what the code or a touch can tell, so that the renderer is set up
     // again every few seconds rather than for every frame, and any frame renders alone as in the stream.
     placement.driftSteps = static_cast<long>(
@@ -203,6 +219,12 @@ core::Calibration Simulator::geometryAt(double seconds) const {
         const Eigen::Isometry3d slide = tableSlide();
         geometry.tableToCamera = geometry.tableToCamera * slide;
         geometry.tableToProjector = geometry.tableToProjector * slide;
+    }
+    // A tilted table's plane is another plane: the code falls elsewhere than the calibration predicts.
+    if (placement.tableTilted) {
+        const Eigen::Isometry3d tilt = tableTilt();
+        geometry.tableToCamera = geometry.tableToCamera * tilt;
+        geometry.tableToProjector = geometry.tableToProjector * tilt;
     }
     // The panel's image moves over the table as its principal point does.
     const Eigen::Vector2d drift = placement.driftSteps * kDriftStepPx * driftDirection();

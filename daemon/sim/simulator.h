@@ -36,8 +36,8 @@ public:
     // does (the camera's image and the truth follow the camera where it is).
     const core::Calibration& calibration() const { return calibration_; }
     // The rig's true geometry at `seconds` into the session: calibration() before a knock, the camera where
-    // the knock put it after; the projector's image moved by its drift; after the table slid, the rig
-    // against the table's new place (the scenario's hands keep to the table).
+    // the knock put it after; the projector's image moved by its drift; after the table slid or tilted, the
+    // rig against the table's new place (the scenario's hands keep to the table).
     core::Calibration geometryAt(double seconds) const;
     const cv::Mat& pattern() const { return pattern_; }
     const Scenario& scenario() const { return *scenario_; }
@@ -83,6 +83,7 @@ private:
     struct Placement {
         bool knocked = false;
         bool tableShifted = false;
+        bool tableTilted = false;
         long driftSteps = 0;  // how far the projector's image has crept, in steps of a fiftieth of a pixel
         bool operator==(const Placement&) const = default;
     };
@@ -91,9 +92,13 @@ private:
     void placeRig(double seconds);
     // The camera's pose after the knock (SimParameters::knockS).
     Eigen::Isometry3d knockedTableToCamera() const;
+    // The point of the table under the display's centre, table mm, as calibrated.
+    Eigen::Vector3d displayCentreOnTable() const;
     // Where the table has slid (SimParameters::tableShiftS): a point of the table that lay at X before lies
     // at slide * X after, both in the table's frame from before.
     Eigen::Isometry3d tableSlide() const;
+    // How the table has tilted (SimParameters::tableTiltS), as tableSlide() says how it slid.
+    Eigen::Isometry3d tableTilt() const;
     // The unit direction, in projector pixels, in which the projector's image creeps.
     Eigen::Vector2d driftDirection() const;
     // Largest distance a wrist or fingertip moves between two scenes, mm.

@@ -1,5 +1,5 @@
 // The simulated rig moving after its calibration (a knocked camera, a creeping projector image, a table that
-// slid): what moves and what stays.
+// slid or tilted): what moves and what stays.
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -170,6 +170,32 @@ TEST(SimTableShift, FramesAfterTheSlideShowTheTablesPrintMovedAndTheCodeInPlace)
     EXPECT_EQ(differs(2), 0.0);
 }
 
+TEST(SimTableTilt, TheTableTiltsAboutALevelAxisThroughTheDisplaysCentreAndTheCodeMoves) {
+    SimParameters parameters = knockedRig(1.0);
+    parameters.knockS.reset();
+    parameters.tableTiltS = 1.0;
+    parameters.tableTiltDeg = 2.0;
+    const Simulator simulator(parameters, rigPattern(parameters));
+    const core::Calibration& calibration = simulator.calibration();
+    const core::Calibration before = simulator.geometryAt(0.99), after = simulator.geometryAt(1.0);
+    EXPECT_TRUE(before.tableToCamera.isApprox(calibration.tableToCamera));
+    // The rig stands against the table as if the table had turned 2 degrees about a level axis through the
+    // display's centre, which stays where it was; both devices keep their places against each other.
+    const Eigen::Isometry3d relative = before.tableToCamera.inverse() * after.tableToCamera;
+    const Eigen::AngleAxisd turn(relative.linear());
+    EXPECT_NEAR(turn.angle() * 180.0 / M_PI, 2.0, 1e-9);
+    EXPECT_NEAR(turn.axis().z(), 0.0, 1e-9);
+    const Eigen::Vector2d centre = core::applyHomography(
+        calibration.displayToTableHomography(),
+        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector3d centre3(centre.x(), centre.y(), 0.0);
+    EXPECT_NEAR((relative * centre3 - centre3).norm(), 0.0, 1e-9);
+    EXPECT_TRUE((before.tableToProjector.inverse() * after.tableToProjector).isApprox(relative));
+    // Another plane: the code falls elsewhere than the calibration predicts.
+    EXPECT_FALSE(after.projectorToCameraHomography().normalized().isApprox(
+        calibration.projectorToCameraHomography().normalized(), 1e-4));
+}
+
 TEST(SimKnock, SpecKeysAreReadAndChecked) {
     SimParameters p;
     EXPECT_EQ(applyOption(p, "knock", "12.5"), std::nullopt);
@@ -205,6 +231,17 @@ TEST(SimKnock, SpecKeysAreReadAndChecked) {
     p = SimParameters();
     p.tableShiftDeg = 20.0;
     EXPECT_NE(p.validate().value_or("").find("table_shift_deg"), std::string::npos);
+    p = SimParameters();
+    EXPECT_EQ(applyOption(p, "table_tilt", "2"), std::nullopt);
+    EXPECT_EQ(applyOption(p, "table_tilt_deg", "3"), std::nullopt);
+    EXPECT_EQ(p.tableTiltS, 2.0);
+    EXPECT_EQ(p.tableTiltDeg, 3.0);
+    EXPECT_EQ(p.validate(), std::nullopt);
+    p.tableTiltDeg = 11.0;
+    EXPECT_NE(p.validate().value_or("").find("table_tilt_deg"), std::string::npos);
+    p = SimParameters();
+    p.tableTiltS = -1.0;
+    EXPECT_NE(p.validate().value_or("").find("table_tilt:"), std::string::npos);
 }
 
 }  // namespace
