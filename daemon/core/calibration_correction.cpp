@@ -20,16 +20,13 @@ namespace {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using Matrix26d = Eigen::Matrix<double, 2, 6>;
 
-// Steps of the numerical derivatives: a microradian turns the table's points by a few thousandths of a camera
-// pixel, a micrometre moves them by less; both far above rounding, far below the curvature of the projection.
+// Steps of the numerical derivatives by the camera's pose and the table's plane: a microradian turns the
+// table's points by a few thousandths of a camera pixel, a micrometre moves them by less; both far above
+// rounding, far below the curvature of the projection.
 constexpr double kTurnStepRad = 1e-6;
 constexpr double kShiftStepMm = 1e-3;
 // Step of the camera-to-projector map's derivative, camera pixels: the map is smooth over a pixel.
 constexpr double kPixelStep = 0.5;
-// Steps of the derivatives by the table's plane: a microradian's tilt and a micrometre's lift, as for the
-// camera's pose.
-constexpr double kTableTurnStepRad = 1e-6;
-constexpr double kTableLiftStepMm = 1e-3;
 // Gauss-Newton steps that refine the table's plane from the first one's linear fit: a tilt of several
 // degrees moves the code nearly linearly, and each step takes what is left to a small fraction.
 constexpr int kTableSteps = 4;
@@ -190,7 +187,7 @@ void CalibrationCorrector::prepareTerms(const std::vector<TileShift>& tiles) {
         Eigen::Matrix<double, 2, 3> tableDerivative;
         for (int k = 0; k < 3; ++k) {
             Eigen::Vector3d move = Eigen::Vector3d::Zero();
-            move[k] = k < 2 ? kTableTurnStepRad : kTableLiftStepMm;
+            move[k] = k < 2 ? kTurnStepRad : kShiftStepMm;
             tableDerivative.col(k) = (seenThrough(withTableMoved(calibration, movedTable(move, tableCentre_)),
                                                   camera, geometry.panelPixel) -
                                       predicted) /
@@ -337,15 +334,12 @@ CalibrationCorrector::Fit CalibrationCorrector::fitMoveRobustly(const std::vecto
 
 double CalibrationCorrector::inlierMisregistrationPx(const Calibration& corrected) const {
     const CameraModel camera{corrected.cameraMatrix, corrected.cameraDistortion};
-    const Eigen::Matrix3d projectorToTable = corrected.tableToProjectorHomography().inverse();
     double squares = 0.0;
     int used = 0;
     for (const TileTerm& term : terms_) {
         if (!term.inlier)
             continue;
-        const Eigen::Vector2d lit = applyHomography(projectorToTable, term.geometry.panelPixel);
-        const Eigen::Vector2d predicted =
-            seenAt(camera, corrected.tableToCamera, Eigen::Vector3d(lit.x(), lit.y(), 0.0));
+        const Eigen::Vector2d predicted = seenThrough(corrected, camera, term.geometry.panelPixel);
         squares += (term.geometry.toProjector * (term.geometry.observed - predicted)).squaredNorm();
         ++used;
     }
