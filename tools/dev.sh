@@ -231,8 +231,9 @@ tsan)
         -E '^(ServiceTest\.ANewUserCalibratesFully|CameraServiceTest\.(CalibratesTheTableThrough|TheAccuracyTestsCircles)|AravisSource\.(Delivers|ReadsColour|ACameraThatGoesAway))' "$@"
     ;;
 fuzz)
-    # clang only for this command: the test suite replays the corpora in every build without it.
-    packages+=(clang)
+    # clang only for this command: the test suite replays the corpora in every build without it. Its
+    # libFuzzer and sanitizer runtimes come with libclang-rt-dev, which clang only recommends.
+    packages+=(clang libclang-rt-dev)
     install_missing_packages
     seconds=${1:-600}
     [ $# -gt 0 ] && shift
