@@ -19,6 +19,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -382,12 +383,12 @@ cv::Mat yuyvOf(const cv::Mat& bgr) {
     return yuyv;
 }
 
-// The touch log as far as the daemon has written it; an entry it is still writing is left for the next look.
-std::vector<io::TouchLogEntry> touchLogSoFar(const std::filesystem::path& path) {
+// The touch log as far as the daemon has written it; nothing while it is writing an entry.
+std::optional<std::vector<io::TouchLogEntry>> touchLogSoFar(const std::filesystem::path& path) {
     try {
         return io::readTouchLog(path);
     } catch (const io::InputError&) {
-        return {};
+        return std::nullopt;
     }
 }
 
@@ -488,7 +489,7 @@ TEST(V4l2SourceOnVivid, TheDaemonDetectsARecordedTouchThroughTheCamera) {
     const auto waitFor = [&](const auto& condition) {
         const auto deadline = std::chrono::steady_clock::now() + 180s;
         while (std::chrono::steady_clock::now() < deadline && daemon.running()) {
-            if (condition(touchLogSoFar(touchLog)))
+            if (const auto log = touchLogSoFar(touchLog); log && condition(*log))
                 return true;
             std::this_thread::sleep_for(200ms);
         }
@@ -496,8 +497,10 @@ TEST(V4l2SourceOnVivid, TheDaemonDetectsARecordedTouchThroughTheCamera) {
     };
 
     std::vector<core::Contact> down;
+    std::uint64_t downIndex = 0;
     ASSERT_TRUE(waitFor([&](const std::vector<io::TouchLogEntry>& log) {
         down = touchingNow(log);
+        downIndex = log.empty() ? 0 : log.back().index;
         return !down.empty();
     })) << "no touch through the camera\n"
         << daemon.output();
@@ -515,8 +518,9 @@ TEST(V4l2SourceOnVivid, TheDaemonDetectsARecordedTouchThroughTheCamera) {
         }
 
     shown = 1;
-    EXPECT_TRUE(waitFor([](const std::vector<io::TouchLogEntry>& log) { return touchingNow(log).empty(); }))
-        << "the touch stayed down after the finger lifted\n"
+    EXPECT_TRUE(waitFor([&](const std::vector<io::TouchLogEntry>& log) {
+        return log.back().index > downIndex && touchingNow(log).empty();
+    })) << "the touch stayed down after the finger lifted\n"
         << daemon.output();
     daemon.signal(SIGTERM);
     const std::optional<int> status = daemon.wait(60s);
