@@ -102,6 +102,10 @@ Eigen::Matrix3d Calibration::displayToTableHomography() const {
     return tableToProjectorHomography().inverse() * displayToProjector;
 }
 
+Eigen::Vector2d Calibration::displayCentreOnTable() const {
+    return applyHomography(displayToTableHomography(), {displaySize.width / 2.0, displaySize.height / 2.0});
+}
+
 cv::Size2d Calibration::displaySizeMm() const {
     const Eigen::Matrix3d h = displayToTableHomography();
     const double w = displaySize.width, hgt = displaySize.height;

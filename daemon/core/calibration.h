@@ -45,6 +45,8 @@ struct Calibration {
     Eigen::Matrix3d cameraToDisplayBelowHomography(double heightMm) const;
     // Display pixels -> table millimetres (where the desktop's pixels land on the table).
     Eigen::Matrix3d displayToTableHomography() const;
+    // The table point, mm, on which the display's centre lands.
+    Eigen::Vector2d displayCentreOnTable() const;
 
     // Physical size of the displayed image on the table, from its four corners (mean of opposite sides), mm.
     cv::Size2d displaySizeMm() const;

@@ -122,9 +122,7 @@ void CalibrationCorrector::setRig(const Calibration& calibration, int tilesPerRo
         throw std::invalid_argument("calibration correction: a round needs at least " +
                                     std::to_string(kMinRelocationTiles) + " tiles");
     calibration_ = calibration;
-    const Eigen::Vector2d centre = applyHomography(
-        calibration.displayToTableHomography(),
-        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector2d centre = calibration.displayCentreOnTable();
     tableCentre_ = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
     tilesPerRound_ = tilesPerRound;
     terms_.reserve(static_cast<std::size_t>(tilesPerRound));
@@ -234,25 +232,27 @@ CalibrationCorrector::Fit CalibrationCorrector::summarise(double squares, double
     return fit;
 }
 
-CalibrationCorrector::Fit CalibrationCorrector::fitImageShift(Eigen::Vector2d& shiftPx) const {
-    Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d right = Eigen::Vector2d::Zero();
+template <int N>
+CalibrationCorrector::Fit CalibrationCorrector::fitLinear(Eigen::Matrix<double, 2, N> TileTerm::*onPanel,
+                                                          Eigen::Matrix<double, N, 1>& parameters) const {
+    Eigen::Matrix<double, N, N> normal = Eigen::Matrix<double, N, N>::Zero();
+    Eigen::Matrix<double, N, 1> right = Eigen::Matrix<double, N, 1>::Zero();
     double squares = 0.0;
     int used = 0;
     for (const TileTerm& term : terms_) {
         if (!term.inlier)
             continue;
-        normal += term.imageOnPanel.transpose() * term.imageOnPanel;
-        right += term.imageOnPanel.transpose() * term.shift;
+        normal += (term.*onPanel).transpose() * (term.*onPanel);
+        right += (term.*onPanel).transpose() * term.shift;
         squares += term.shift.squaredNorm();
         ++used;
     }
-    shiftPx = normal.ldlt().solve(right);
+    parameters = solveBalanced<N>(normal, right);
     double left = 0.0;
     for (const TileTerm& term : terms_)
         if (term.inlier)
-            left += (term.shift - term.imageOnPanel * shiftPx).squaredNorm();
-    return summarise(squares, left, used, 2);
+            left += (term.shift - term.*onPanel * parameters).squaredNorm();
+    return summarise(squares, left, used, N);
 }
 
 Eigen::Vector2d CalibrationCorrector::seenThrough(const Calibration& calibration, const CameraModel& camera,
@@ -260,27 +260,6 @@ Eigen::Vector2d CalibrationCorrector::seenThrough(const Calibration& calibration
     const Eigen::Vector2d lit =
         applyHomography(calibration.tableToProjectorHomography().inverse(), panelPixel);
     return seenAt(camera, calibration.tableToCamera, Eigen::Vector3d(lit.x(), lit.y(), 0.0));
-}
-
-CalibrationCorrector::Fit CalibrationCorrector::fitTable(Eigen::Vector3d& move) const {
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d right = Eigen::Vector3d::Zero();
-    double squares = 0.0;
-    int used = 0;
-    for (const TileTerm& term : terms_) {
-        if (!term.inlier)
-            continue;
-        normal += term.tableOnPanel.transpose() * term.tableOnPanel;
-        right += term.tableOnPanel.transpose() * term.shift;
-        squares += term.shift.squaredNorm();
-        ++used;
-    }
-    move = solveBalanced<3>(normal, right);
-    double left = 0.0;
-    for (const TileTerm& term : terms_)
-        if (term.inlier)
-            left += (term.shift - term.tableOnPanel * move).squaredNorm();
-    return summarise(squares, left, used, 3);
 }
 
 Calibration CalibrationCorrector::refinedTable(Eigen::Vector3d move) const {
@@ -364,9 +343,9 @@ std::optional<CalibrationCorrection> CalibrationCorrector::update(std::uint64_t 
     };
     const Fit move = fitMoveRobustly(latest);
     Eigen::Vector2d imageShiftPx;
-    const Fit image = fitImageShift(imageShiftPx);
+    const Fit image = fitLinear(&TileTerm::imageOnPanel, imageShiftPx);
     Eigen::Vector3d tableMove;
-    const Fit table = fitTable(tableMove);
+    const Fit table = fitLinear(&TileTerm::tableOnPanel, tableMove);
     // What would count as the calibration holding (below) is what a correction may leave.
     const double allowedPx =
         std::max(options_.leastErrorPx, options_.noiseMultiple * heldNoisePx_.value_or(0.0));

@@ -112,11 +112,12 @@ private:
     static Fit summarise(double squares, double left, int tiles, int parameters);
     Fit fitMove();  // over the inlier terms
     Fit fitMoveRobustly(const std::vector<TileShift>& tiles);
-    // The shift of the projector's image on its panel that fits the inlier terms best.
-    Fit fitImageShift(Eigen::Vector2d& shiftPx) const;
-    // The move of the table's plane (turns about its x and y axes through the display's centre, radians;
-    // a lift, mm) that fits the inlier terms best, linearised.
-    Fit fitTable(Eigen::Vector3d& move) const;
+    // The parameters of a linear explanation that fit the inlier terms best, each term's shifts per parameter
+    // in `onPanel`: the projector image's shift (imageOnPanel, projector pixels) or the table's plane's move
+    // (tableOnPanel: turns about its level axes through the display's centre, radians, and a lift, mm).
+    template <int N>
+    Fit fitLinear(Eigen::Matrix<double, 2, N> TileTerm::*onPanel,
+                  Eigen::Matrix<double, N, 1>& parameters) const;
     // The calibration with the table's plane moved, refined from the linear fit `move` over the inlier terms.
     Calibration refinedTable(Eigen::Vector3d move) const;
     // Where the camera of `calibration` sees the light of projector pixel `panelPixel` on its table.

@@ -75,9 +75,7 @@ void RegistrationCheck::setRig(const Calibration& calibration, const cv::Mat& pa
 
     // The search's reach in camera pixels, from the table's scale at the display's centre.
     const Eigen::Matrix3d tableToCamera = calibration.tableToCameraHomography();
-    const Eigen::Vector2d centreMm =
-        applyHomography(calibration.displayToTableHomography(),
-                        {calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0});
+    const Eigen::Vector2d centreMm = calibration.displayCentreOnTable();
     const double pixelsPerMm = (applyHomography(tableToCamera, centreMm + Eigen::Vector2d(1.0, 0.0)) -
                                 applyHomography(tableToCamera, centreMm))
                                    .norm();

@@ -136,9 +136,7 @@ void SurfaceHeight::setRig(const Calibration& calibration, const cv::Mat& patter
     CV_Assert(pattern.type() == CV_8UC1 && pattern.size() == calibration.projectorSize);
     // The scales at the display's centre: a camera pixel's footprint and a millimetre, in projector pixels.
     const Eigen::Matrix3d tableToProjector = calibration.tableToProjectorHomography(0.0);
-    const Eigen::Vector2d centreMm = applyHomography(
-        calibration.displayToTableHomography(),
-        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector2d centreMm = calibration.displayCentreOnTable();
     const double projectorPixelsPerMm =
         (applyHomography(tableToProjector, centreMm + Eigen::Vector2d(0.5, 0)) -
          applyHomography(tableToProjector, centreMm - Eigen::Vector2d(0.5, 0)))

@@ -125,9 +125,7 @@ Renderer::Renderer(const SimParameters& parameters, const core::Calibration& cal
         (calibration.projectorMatrix * calibration.tableToProjector.translation()).cast<float>();
     cameraToProjector_ = calibration.cameraToProjectorHomography(0.0);
 
-    const Eigen::Matrix3d displayToTable = calibration.displayToTableHomography();
-    const Eigen::Vector2d centre = core::applyHomography(
-        displayToTable, {calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0});
+    const Eigen::Vector2d centre = calibration.displayCentreOnTable();
     referenceDistance2_ = (projectorCentre_ - Eigen::Vector3d(centre.x(), centre.y(), 0)).squaredNorm();
     referenceCosine_ = projectorCentre_.z() / std::sqrt(referenceDistance2_);
 

@@ -160,18 +160,12 @@ Eigen::Isometry3d Simulator::knockedTableToCamera() const {
     return after;
 }
 
-Eigen::Vector3d Simulator::displayCentreOnTable() const {
-    const Eigen::Vector2d centre = core::applyHomography(
-        calibration_.displayToTableHomography(),
-        Eigen::Vector2d(calibration_.displaySize.width / 2.0, calibration_.displaySize.height / 2.0));
-    return {centre.x(), centre.y(), 0.0};
-}
-
 Eigen::Isometry3d Simulator::tableSlide() const {
     std::mt19937_64 random(mix(parameters_.seed ^ 0x736C696465ull));
     const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
     const double turn = (std::bernoulli_distribution(0.5)(random) ? 1.0 : -1.0) * parameters_.tableShiftDeg;
-    const Eigen::Vector3d centre = displayCentreOnTable();
+    const Eigen::Vector2d onTable = calibration_.displayCentreOnTable();
+    const Eigen::Vector3d centre(onTable.x(), onTable.y(), 0.0);
     Eigen::Isometry3d slide = Eigen::Isometry3d::Identity();
     slide.linear() = Eigen::AngleAxisd(turn * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     slide.translation() = centre - slide.linear() * centre +
@@ -182,7 +176,8 @@ Eigen::Isometry3d Simulator::tableSlide() const {
 Eigen::Isometry3d Simulator::tableTilt() const {
     std::mt19937_64 random(mix(parameters_.seed ^ 0x74696C74ull));
     const double angle = std::uniform_real_distribution<double>(0.0, 2.0 * M_PI)(random);
-    const Eigen::Vector3d centre = displayCentreOnTable();
+    const Eigen::Vector2d onTable = calibration_.displayCentreOnTable();
+    const Eigen::Vector3d centre(onTable.x(), onTable.y(), 0.0);
     const Eigen::Vector3d axis(std::cos(angle), std::sin(angle), 0.0);
     Eigen::Isometry3d tilt = Eigen::Isometry3d::Identity();
     tilt.linear() = Eigen::AngleAxisd(parameters_.tableTiltDeg * M_PI / 180.0, axis).toRotationMatrix();

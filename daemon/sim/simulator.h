@@ -92,8 +92,6 @@ private:
     void placeRig(double seconds);
     // The camera's pose after the knock (SimParameters::knockS).
     Eigen::Isometry3d knockedTableToCamera() const;
-    // The point of the table under the display's centre, table mm, as calibrated.
-    Eigen::Vector3d displayCentreOnTable() const;
     // Where the table has slid (SimParameters::tableShiftS): a point of the table that lay at X before lies
     // at slide * X after, both in the table's frame from before.
     Eigen::Isometry3d tableSlide() const;

@@ -361,9 +361,7 @@ TEST(CalibrationCorrector, CorrectsATiltedTableAsItsPlaneAndTheCodeFitsAgain) {
     const RenderedRig& rig = calibratedRig();
     std::vector<TileShift> tiles = check(rig, kRenderedPairs).tiles;
     ASSERT_EQ(tiles.size(), 16u);
-    const Eigen::Vector2d middle = applyHomography(
-        rig.calibration.displayToTableHomography(),
-        Eigen::Vector2d(rig.calibration.displaySize.width / 2.0, rig.calibration.displaySize.height / 2.0));
+    const Eigen::Vector2d middle = rig.calibration.displayCentreOnTable();
     // A leg on a cable: 2, 4 and 6 degrees about axes through the display's centre and 100 mm beside it,
     // each with a twentieth of a camera pixel of noise.
     cv::RNG rng(3);

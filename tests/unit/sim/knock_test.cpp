@@ -145,9 +145,7 @@ TEST(SimTableShift, TheTableSlidesAndTurnsInItsPlaneAndTheCodeStaysWhereTheCalib
     const Eigen::Isometry3d relative = before.tableToCamera.inverse() * after.tableToCamera;
     EXPECT_NEAR(Eigen::AngleAxisd(relative.linear()).angle() * 180.0 / M_PI, 1.0, 1e-9);
     EXPECT_NEAR(std::abs(Eigen::AngleAxisd(relative.linear()).axis().z()), 1.0, 1e-9);
-    const Eigen::Vector2d centre = core::applyHomography(
-        calibration.displayToTableHomography(),
-        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector2d centre = calibration.displayCentreOnTable();
     const Eigen::Vector3d centre3(centre.x(), centre.y(), 0.0);
     EXPECT_NEAR((relative * centre3 - centre3).norm(), 5.0, 1e-9);
     EXPECT_NEAR((relative * centre3 - centre3).z(), 0.0, 1e-9);
@@ -185,9 +183,7 @@ TEST(SimTableTilt, TheTableTiltsAboutALevelAxisThroughTheDisplaysCentreAndTheCod
     const Eigen::AngleAxisd turn(relative.linear());
     EXPECT_NEAR(turn.angle() * 180.0 / M_PI, 2.0, 1e-9);
     EXPECT_NEAR(turn.axis().z(), 0.0, 1e-9);
-    const Eigen::Vector2d centre = core::applyHomography(
-        calibration.displayToTableHomography(),
-        Eigen::Vector2d(calibration.displaySize.width / 2.0, calibration.displaySize.height / 2.0));
+    const Eigen::Vector2d centre = calibration.displayCentreOnTable();
     const Eigen::Vector3d centre3(centre.x(), centre.y(), 0.0);
     EXPECT_NEAR((relative * centre3 - centre3).norm(), 0.0, 1e-9);
     EXPECT_TRUE((before.tableToProjector.inverse() * after.tableToProjector).isApprox(relative));
