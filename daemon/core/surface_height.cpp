@@ -698,7 +698,7 @@ HeightEstimate SurfaceHeight::estimate(const HeightEvidence& evidence, std::opti
     }
     result.valid = true;
     result.heightMm = (static_cast<double>(best) + offset) * options_.stepMm;
-    result.padHeightMm = std::max(0.0, result.heightMm - evidence.topAbovePadTimesPixels / evidence.pixels);
+    result.padHeightMm = result.heightMm - evidence.topAbovePadTimesPixels / evidence.pixels;
     // The peak's width in height over its height above chance: a sharp, strong peak pins the height down.
     result.uncertaintyMm = options_.stepMm * chance / std::max(bestCorrelation, chance) * 4.0;
     return result;

@@ -96,8 +96,10 @@ struct HeightEstimate {
     // The code was seen on the fingertip well enough to tell a height, its best height lies below the top
     // of the range, and no other height comes near it.
     bool valid = false;
-    double heightMm = 0.0;       // of the visible surface above the table: for a fingertip, its top
-    double padHeightMm = 0.0;    // of its lowest point, by the fingertip's shape; heightMm otherwise
+    double heightMm = 0.0;  // of the visible surface above the table: for a fingertip, its top
+    // Of its lowest point, by the fingertip's shape (heightMm otherwise): below the table (negative) when the
+    // surface read lies lower than the shape's top can.
+    double padHeightMm = 0.0;
     double correlation = 0.0;    // at that height
     double uncertaintyMm = 0.0;  // one standard deviation
 };

@@ -41,6 +41,8 @@ constexpr int kPairsBetweenBlurMeasurements = 30;
 // is the code that moved. A knock that turns the camera shifts the code by different amounts across the
 // table, so single tiles within the limit come and go while it holds.
 constexpr std::size_t kTilesRunning = 3;
+// A pad read further below the table than this many deviations of its height is no finger's.
+constexpr double kBelowTableDeviations = 3.0;
 constexpr std::string_view kHeldBackProblem =
     "the code lies further from where the calibration puts it than the table can be told from a hand at, and "
     "no touch is reported";
@@ -341,14 +343,22 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
         FingertipObservation& observation = result_.fingertips.emplace_back();
         observation.fingertip = tip;
         observation.visible = height_.estimate(memory.evidence, slope);
+        const double uncertaintyMm = std::hypot(observation.visible.uncertaintyMm, options_.visibleSpreadMm);
         // Without a height (the code on it not seen well enough) the pad is placed on the table: the
         // tracker uses it only for a finger that touches.
         if (observation.visible.valid)
-            observation.padHeightMm = observation.visible.padHeightMm;
+            observation.padHeightMm = std::max(0.0, observation.visible.padHeightMm);
         // The contact point: the display pixel straight below the pad, at the height it was read.
         const Eigen::Vector2d undistorted = camera.undistortPixel(tip.pad);
         observation.display =
             applyHomography(calibration.cameraToDisplayBelowHomography(observation.padHeightMm), undistorted);
+        // The code there lies on the table itself, a finger's thickness and more below any fingertip's top:
+        // the segmentation took a patch of table for skin (an empty table whose code has crept a little off
+        // its prediction, between the corrections; the table between spread fingers over dark content).
+        // The tracker sees no finger there rather than one resting on the table.
+        if (observation.visible.valid &&
+            observation.visible.padHeightMm < -kBelowTableDeviations * uncertaintyMm)
+            continue;
         FingerObservation& finger = observations_.emplace_back();
         finger.display = observation.display;
         finger.heightKnown = observation.visible.valid;
@@ -359,8 +369,7 @@ void TouchPipeline::measureFingertips(const FramePair& pair, const PipelineSetti
             finger.codeFavoursTable = height_.favoursPadUpTo(memory.evidence, settings.touchHeightMm, slope);
         finger.padHeightMm = observation.padHeightMm;
         if (finger.heightKnown)
-            finger.heightUncertaintyMm =
-                std::hypot(observation.visible.uncertaintyMm, options_.visibleSpreadMm);
+            finger.heightUncertaintyMm = uncertaintyMm;
     }
     std::swap(remembered_, rememberedNext_);
     rememberedCount_ = next;

@@ -11,22 +11,41 @@ bool sameImage(const cv::Mat& a, const cv::Mat& b) {
     return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) <= 1.0;
 }
 
+namespace {
+
+// The pause before the next grab. A grab that waits for the compositor's next frame and takes as many
+// refreshes each time sees the same one of two alternating images every time (a loaded machine's grabs of
+// the headless sway took two frames each and saw one polarity for seconds); each grab that repeats an image
+// already grabbed shifts the next by another 5 ms, a third of a 60 Hz refresh, so the phase walks over both.
+void keep(const cv::Mat& screen, cv::Mat& grabbed, int& repeats) {
+    if (!grabbed.empty())
+        ++repeats;
+    grabbed = screen;
+}
+
+void pauseBeforeTheNextGrab(int repeats) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(3 + 5 * (repeats % 4)));
+}
+
+}  // namespace
+
 AlternateGrabs grabAlternates(const std::function<cv::Mat()>& grab, const cv::Mat& positive,
                               const cv::Mat& negative) {
     AlternateGrabs grabbed;
     bool matched = false;
+    int repeats = 0;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
            std::chrono::steady_clock::now() < deadline) {
         const cv::Mat screen = grab();
         if (sameImage(screen, positive))
-            grabbed.positive = screen;
+            keep(screen, grabbed.positive, repeats);
         else if (sameImage(screen, negative))
-            grabbed.negative = screen;
+            keep(screen, grabbed.negative, repeats);
         else if (matched)
             ++grabbed.others;
         matched = matched || !grabbed.positive.empty() || !grabbed.negative.empty();
-        std::this_thread::sleep_for(std::chrono::milliseconds(3));
+        pauseBeforeTheNextGrab(repeats);
     }
     return grabbed;
 }
@@ -46,6 +65,7 @@ AlternateGrabs grabBothPolarities(const std::function<cv::Mat()>& grab, const cv
         return spread[0] < 1.0 && spread[1] < 1.0 && spread[2] < 1.0;
     };
     AlternateGrabs grabbed;
+    int repeats = 0;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while ((grabbed.positive.empty() || grabbed.negative.empty()) &&
            std::chrono::steady_clock::now() < deadline) {
@@ -59,12 +79,12 @@ AlternateGrabs grabBothPolarities(const std::function<cv::Mat()>& grab, const cv
         if (!uniform(spreadOnOnes) || !uniform(spreadOnZeros))
             ++grabbed.others;
         else if (brighter >= delta)
-            grabbed.positive = screen;
+            keep(screen, grabbed.positive, repeats);
         else if (brighter <= -delta)
-            grabbed.negative = screen;
+            keep(screen, grabbed.negative, repeats);
         else
             ++grabbed.others;
-        std::this_thread::sleep_for(std::chrono::milliseconds(3));
+        pauseBeforeTheNextGrab(repeats);
     }
     return grabbed;
 }

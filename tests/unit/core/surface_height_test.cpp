@@ -37,6 +37,23 @@ TEST(SurfaceHeight, OnePeakGivesItsHeight) {
     EXPECT_NEAR(estimate.correlation, 0.5, 1e-9);
 }
 
+TEST(SurfaceHeight, APadReadBelowTheTableIsSaidSoNotPutOnTheTable) {
+    // A fingertip's top 12 mm above its pad: its surface read at 12 mm puts the pad on the table, read at
+    // 2 mm (the table's code on a region the segmentation took for skin) 10 mm below it, which no finger is.
+    const SurfaceHeight height{HeightOptions{}};
+    const auto fingertipWithPeakAt = [](double atMm) {
+        HeightEvidence evidence = evidenceWith(200, [atMm](double h) { return peak(h, atMm, 0.5); });
+        evidence.topAbovePadTimesPixels = 12.0 * evidence.pixels;
+        return evidence;
+    };
+    const HeightEstimate resting = height.estimate(fingertipWithPeakAt(12));
+    ASSERT_TRUE(resting.valid);
+    EXPECT_NEAR(resting.padHeightMm, 0.0, 0.2);
+    const HeightEstimate table = height.estimate(fingertipWithPeakAt(2));
+    ASSERT_TRUE(table.valid);
+    EXPECT_NEAR(table.padHeightMm, -10.0, 0.2);
+}
+
 TEST(SurfaceHeight, TwoPeaksAboutAsHighGiveNoHeight) {
     // Over 200 pixels chance correlations spread by 0.1: a second peak 0.05 lower is as likely the surface.
     const SurfaceHeight height{HeightOptions{}};
