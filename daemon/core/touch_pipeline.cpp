@@ -200,6 +200,14 @@ void TouchPipeline::adoptCorrection(const CalibrationCorrection& correction,
 void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSettings& settings) {
     if (codeBlurMeasured_ || !codeBlur_.hasRig() || pairsUntilBlurMeasure_-- > 0)
         return;
+    // Only where the check finds the code as the calibration predicts it: a code that lies off it (a camera
+    // knocked before detection started) follows a prediction blurred far beyond the rig's blur best (2.1
+    // camera px instead of 0.92 for a knock that put it 10 projector px off), and the check, predicting
+    // through that blur, then found no shift consistent enough to correct. Until then the stages predict
+    // with the default blur.
+    if (const std::optional<double> errorPx = registration_.errorPx();
+        !errorPx || *errorPx > heldBackBeyondPx_)
+        return;
     const std::optional<double> blur = codeBlur_.measure(subtraction);
     if (!blur) {
         pairsUntilBlurMeasure_ = kPairsBetweenBlurMeasurements;
@@ -207,6 +215,10 @@ void TouchPipeline::measureCodeBlur(const cv::Mat& subtraction, const PipelineSe
     }
     // Once: a rig's focus does not change while it runs, and a new calibration measures it again.
     codeBlurMeasured_ = true;
+    // Measured again after a correction, the blur the stages predict with already: the check goes on with the
+    // tiles it has instead of starting over.
+    if (codeBlurPx_ && std::abs(*codeBlurPx_ - *blur) < 0.5 * CodeBlurMeter::kStepPx)
+        return;
     codeBlurPx_ = *blur;
     segmenter_.setRig(*rigCalibration_, settings.pattern, *blur);
     polarityLock_.setRig(segmenter_.tableCode(), segmenter_.judgedRegion());
