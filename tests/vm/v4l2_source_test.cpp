@@ -519,7 +519,7 @@ TEST(V4l2SourceOnVivid, TheDaemonDetectsARecordedTouchThroughTheCamera) {
 
     shown = 1;
     EXPECT_TRUE(waitFor([&](const std::vector<io::TouchLogEntry>& log) {
-        return log.back().index > downIndex && touchingNow(log).empty();
+        return !log.empty() && log.back().index > downIndex && touchingNow(log).empty();
     })) << "the touch stayed down after the finger lifted\n"
         << daemon.output();
     daemon.signal(SIGTERM);
